@@ -1,0 +1,29 @@
+// Small geometry vocabulary shared by every stage. Eigen does the arithmetic; these aliases keep
+// signatures short and make the float/double choice in one place (float: it is what the GPU and
+// the C ABI carry).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <cmath>
+
+namespace drape {
+
+using Vec3 = Eigen::Vector3f;
+using Mat3 = Eigen::Matrix3f;
+using Quat = Eigen::Quaternionf;
+
+constexpr float kPi = 3.14159265358979323846f;
+
+inline bool isFinite(const Vec3& v) {
+  return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
+}
+
+// A unit vector perpendicular to `n` (n need not be normalised but must be non-zero).
+inline Vec3 anyPerpendicular(const Vec3& n) {
+  const Vec3 a = std::fabs(n.x()) < 0.9f * n.norm() ? Vec3::UnitX() : Vec3::UnitY();
+  return n.cross(a).normalized();
+}
+
+}  // namespace drape
