@@ -1,0 +1,336 @@
+/*
+ * drape.h — the whole public C ABI of Drape, a real-time virtual dressing engine.
+ *
+ * Conventions (read once, they hold for every function below):
+ *  - Prefix `drape_`, snake_case. Every function returns a drape_result (DRAPE_OK = 0) unless it is
+ *    a pure query documented otherwise. On failure, drape_last_error() returns a message for the
+ *    calling thread's last failed call; the message is never needed to tell that a call failed.
+ *  - Handles are opaque pointers. A destroyed, never-created or foreign pointer passed as a handle
+ *    returns DRAPE_ERROR_INVALID_HANDLE; it is never dereferenced.
+ *  - `*_desc`/`*_shape` structs start with `struct_size`: fill them with their `*_init` function
+ *    (sets defaults and struct_size) and then change the fields you need. A struct_size smaller than
+ *    the first released version of the struct is rejected, so uninitialised structs are caught.
+ *  - Buffers: the caller allocates and passes (pointer, capacity); the library writes and never keeps
+ *    the pointer. Size queries tell the capacity needed. Nothing the caller owns is modified when a
+ *    call fails.
+ *  - Units: metres, seconds, kilograms; girths in millimetres. Positions in a right-handed camera
+ *    space. Vectors are {float x, y, z}, layout-compatible with Unity's Vector3.
+ *  - Threading: one thread at a time per drape_context (the caller serialises calls on one context);
+ *    different contexts may be used from different threads at the same time. drape_last_error() is
+ *    per thread. Functions without a context are safe from any thread.
+ *  - No C++ exception, abort or assert crosses this boundary; NaN/Inf inputs are rejected.
+ */
+#ifndef DRAPE_H
+#define DRAPE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#define DRAPE_VERSION_MAJOR 0
+#define DRAPE_VERSION_MINOR 1
+#define DRAPE_VERSION_PATCH 0
+/* Packed version: major << 22 | minor << 12 | patch (as returned by drape_version()). */
+#define DRAPE_MAKE_VERSION(major, minor, patch) \
+  ((((uint32_t)(major)) << 22) | (((uint32_t)(minor)) << 12) | ((uint32_t)(patch)))
+#define DRAPE_VERSION DRAPE_MAKE_VERSION(DRAPE_VERSION_MAJOR, DRAPE_VERSION_MINOR, DRAPE_VERSION_PATCH)
+
+#if defined(_WIN32)
+#  define DRAPE_CALL __cdecl
+#  if defined(DRAPE_BUILDING_LIBRARY)
+#    define DRAPE_API __declspec(dllexport)
+#  else
+#    define DRAPE_API __declspec(dllimport)
+#  endif
+#else
+#  define DRAPE_CALL
+#  define DRAPE_API __attribute__((visibility("default")))
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------------------------------------------ */
+/* Results and errors                                                                          */
+/* ------------------------------------------------------------------------------------------ */
+
+typedef enum drape_result {
+  DRAPE_OK = 0,
+  DRAPE_ERROR_NULL_ARGUMENT = 1,     /* a required pointer was NULL */
+  DRAPE_ERROR_INVALID_ARGUMENT = 2,  /* a value is malformed (bad struct_size, bad combination) */
+  DRAPE_ERROR_INVALID_HANDLE = 3,    /* the handle is not a live object of the expected kind */
+  DRAPE_ERROR_BUFFER_TOO_SMALL = 4,  /* capacity below the size query's answer; nothing written */
+  DRAPE_ERROR_NONFINITE = 5,         /* a NaN or Inf (or absurdly large) number was passed */
+  DRAPE_ERROR_OUT_OF_RANGE = 6,      /* a number or enum is outside its documented range */
+  DRAPE_ERROR_CALL_ORDER = 7,        /* the call needs an earlier one (e.g. read before update) */
+  DRAPE_ERROR_TIMESTAMP = 8,         /* a frame's timestamp is not after the previous frame's */
+  DRAPE_ERROR_IO = 9,                /* a file could not be opened or read */
+  DRAPE_ERROR_PARSE = 10,            /* a file or buffer is not in a format Drape reads */
+  DRAPE_ERROR_OUT_OF_MEMORY = 11,
+  DRAPE_ERROR_INTERNAL = 12,         /* a bug in Drape: please report with drape_last_error() */
+  DRAPE_RESULT_FORCE32 = 0x7fffffff
+} drape_result;
+
+/* Static name of a result code ("DRAPE_OK", ...). Never NULL. Any thread. */
+DRAPE_API const char* DRAPE_CALL drape_result_name(drape_result result);
+
+/* Message describing the calling thread's most recent failed call ("" if none). The string is
+ * owned by the library and valid until the next failing call on this thread. Any thread. */
+DRAPE_API const char* DRAPE_CALL drape_last_error(void);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Version                                                                                     */
+/* ------------------------------------------------------------------------------------------ */
+
+/* The library's packed version (DRAPE_MAKE_VERSION). Compare its major part with
+ * DRAPE_VERSION_MAJOR to detect a mismatched binary. Any thread. */
+DRAPE_API uint32_t DRAPE_CALL drape_version(void);
+/* "major.minor.patch", static. Any thread. */
+DRAPE_API const char* DRAPE_CALL drape_version_string(void);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Basic types                                                                                 */
+/* ------------------------------------------------------------------------------------------ */
+
+typedef struct drape_vec3 { float x, y, z; } drape_vec3;
+typedef struct drape_quat { float x, y, z, w; } drape_quat;
+
+/* Sensor joint layouts. Joint order is the sensor SDK's own (docs/skeleton.md lists them). */
+typedef enum drape_layout {
+  DRAPE_LAYOUT_AUTO = 0,     /* only where documented (recording readers) */
+  DRAPE_LAYOUT_KINECT1 = 1,  /* 20 joints, NUI_SKELETON_POSITION_INDEX order */
+  DRAPE_LAYOUT_KINECT2 = 2,  /* 25 joints, Kinect SDK 2.0 JointType order */
+  DRAPE_LAYOUT_AZURE = 3,    /* 32 joints, k4abt_joint_id order; convert millimetres to metres */
+  DRAPE_LAYOUT_FORCE32 = 0x7fffffff
+} drape_layout;
+
+typedef enum drape_tracking_state {
+  DRAPE_TRACKING_NOT_TRACKED = 0,
+  DRAPE_TRACKING_INFERRED = 1,
+  DRAPE_TRACKING_TRACKED = 2,
+  DRAPE_TRACKING_FORCE32 = 0x7fffffff
+} drape_tracking_state;
+
+/* One joint as the sensor reports it. 16 bytes. */
+typedef struct drape_joint {
+  drape_vec3 position;    /* metres, camera space */
+  int32_t tracking_state; /* drape_tracking_state */
+} drape_joint;
+
+/* ------------------------------------------------------------------------------------------ */
+/* Context                                                                                     */
+/* ------------------------------------------------------------------------------------------ */
+
+typedef struct drape_context drape_context;
+
+typedef enum drape_filter {
+  DRAPE_FILTER_NONE = 0,
+  DRAPE_FILTER_ONE_EURO = 1,           /* Casiez et al. 2012; default */
+  DRAPE_FILTER_DOUBLE_EXPONENTIAL = 2, /* Kinect SDK-style Holt filter */
+  DRAPE_FILTER_FORCE32 = 0x7fffffff
+} drape_filter;
+
+typedef struct drape_context_desc {
+  uint32_t struct_size;          /* sizeof(drape_context_desc), set by drape_context_desc_init */
+  uint32_t ring_points;          /* K, points per feature ring: multiple of 4 in [8, 256]; 20 */
+  uint32_t rings_per_segment;    /* extra rings between two ring stations: [0, 16]; default 1 */
+  uint32_t calibration_frames;   /* frames over which bone lengths are measured, then held:
+                                    [1, 100000]; default 30 */
+  int32_t filter;                /* drape_filter; default DRAPE_FILTER_ONE_EURO */
+  float filter_min_cutoff_hz;    /* One-Euro minimum cutoff (Hz), > 0 */
+  float filter_beta;             /* One-Euro speed coefficient, >= 0 */
+  float filter_d_cutoff_hz;      /* One-Euro derivative cutoff (Hz), > 0 */
+  float smoothing;               /* double exponential: [0, 1) */
+  float correction;              /* double exponential: [0, 1] */
+  float prediction;              /* double exponential: [0, 10] */
+  float jitter_radius_m;         /* double exponential: >= 0 */
+  float max_deviation_m;         /* double exponential: >= 0 */
+  float teleport_distance_m;     /* a pelvis jump beyond this (plus what 5 m/s covers in the
+                                    frame's dt) is reported as a teleport; (0, 100]; 0.5 */
+} drape_context_desc;
+
+/* Fills `desc` with defaults and struct_size. */
+DRAPE_API drape_result DRAPE_CALL drape_context_desc_init(drape_context_desc* desc);
+
+/* Creates a context: one tracked person and (from later versions) their garments. The body starts
+ * with the default shape (drape_body_shape_init). `desc` may be NULL for all defaults. On success
+ * *out_context owns a new context the caller must release with drape_context_destroy.
+ * Thread-safety: any thread. */
+DRAPE_API drape_result DRAPE_CALL drape_context_create(const drape_context_desc* desc,
+                                                       drape_context** out_context);
+
+/* Destroys a context and every buffer it owns. Views into it become invalid. A NULL context is
+ * accepted and ignored (DRAPE_OK); a stale handle returns DRAPE_ERROR_INVALID_HANDLE.
+ * Thread-safety: no other call may be running on this context. */
+DRAPE_API drape_result DRAPE_CALL drape_context_destroy(drape_context* context);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Body shape                                                                                  */
+/* ------------------------------------------------------------------------------------------ */
+
+typedef enum drape_sex {
+  DRAPE_SEX_UNSPECIFIED = 0,
+  DRAPE_SEX_FEMALE = 1,
+  DRAPE_SEX_MALE = 2,
+  DRAPE_SEX_FORCE32 = 0x7fffffff
+} drape_sex;
+
+/* Basic information about the person. Girths are circumferences in millimetres; 0 means
+ * "predict from height and weight" (ANSUR II regression, docs/body-shape.md). */
+typedef struct drape_body_shape {
+  uint32_t struct_size; /* sizeof(drape_body_shape), set by drape_body_shape_init */
+  int32_t sex;          /* drape_sex; stored and reported (the regression data is female-only) */
+  float height_m;       /* stature, [0.8, 2.5]; default 1.70 */
+  float weight_kg;      /* [15, 300]; default 65 */
+  float neck_mm, chest_mm, waist_mm, hip_mm;             /* each 0 or [50, 3000] */
+  float thigh_mm, calf_mm, upper_arm_mm, forearm_mm;     /* each 0 or [50, 3000] */
+} drape_body_shape;
+
+/* Fills `shape` with the default body (1.70 m, 65 kg, girths predicted) and struct_size. */
+DRAPE_API drape_result DRAPE_CALL drape_body_shape_init(drape_body_shape* shape);
+
+/* Sets the body shape. The mesh topology does not change; the next update rebuilds the rings.
+ * On failure the previous shape is kept. Thread-safety: one thread per context. */
+DRAPE_API drape_result DRAPE_CALL drape_context_set_body_shape(drape_context* context,
+                                                               const drape_body_shape* shape);
+
+/* Reads the shape in use with every girth resolved (predicted ones filled in).
+ * `out_shape->struct_size` must be set by the caller (drape_body_shape_init does). */
+DRAPE_API drape_result DRAPE_CALL drape_context_get_body_shape(drape_context* context,
+                                                               drape_body_shape* out_shape);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Skeleton input                                                                              */
+/* ------------------------------------------------------------------------------------------ */
+
+typedef struct drape_skeleton_frame {
+  uint32_t struct_size;            /* sizeof(drape_skeleton_frame) */
+  int32_t layout;                  /* drape_layout (not AUTO) */
+  uint32_t joint_count;            /* must equal the layout's joint count (20, 25, 32) */
+  uint32_t reserved;               /* 0 */
+  double timestamp_s;              /* strictly increasing from frame to frame */
+  const drape_joint* joints;       /* joint_count joints, in the layout's order */
+  const drape_quat* orientations;  /* optional (NULL): joint_count unit quaternions; validated
+                                      and stored for the host, the body follows positions */
+} drape_skeleton_frame;
+
+/* Validates one frame and queues it for the next drape_context_update. A rejected frame (bad
+ * layout, count, NaN/Inf or |coordinate| > 1000 m, timestamp not after the previous accepted
+ * frame) returns an error, is counted in drape_frame_stats.frames_rejected and leaves every bit of
+ * the context's state as it was. Pushing twice without an update replaces the queued frame (the
+ * newest wins; the replaced one counts as dropped). Thread-safety: one thread per context. */
+DRAPE_API drape_result DRAPE_CALL drape_context_push_skeleton(drape_context* context,
+                                                              const drape_skeleton_frame* frame);
+
+/* Runs the pipeline on the queued frame: skeleton filter -> feature rings -> body mesh.
+ * DRAPE_ERROR_CALL_ORDER if no frame was ever pushed. Calling it again without a new frame is
+ * allowed and cheap (nothing changes). Thread-safety: one thread per context. */
+DRAPE_API drape_result DRAPE_CALL drape_context_update(drape_context* context);
+
+/* Reads the filtered canonical skeleton (21 joints, order in docs/skeleton.md) after an update.
+ * positions: capacity >= 21. out_count (optional) receives 21. */
+DRAPE_API drape_result DRAPE_CALL drape_context_read_skeleton(drape_context* context,
+                                                              drape_vec3* positions,
+                                                              uint32_t capacity,
+                                                              uint32_t* out_count);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Body mesh                                                                                   */
+/* ------------------------------------------------------------------------------------------ */
+
+/* Size query: vertex and index counts of the body mesh (fixed for a context: they depend only on
+ * ring_points and rings_per_segment). Either out pointer may be NULL. */
+DRAPE_API drape_result DRAPE_CALL drape_context_get_body_mesh_size(drape_context* context,
+                                                                   uint32_t* out_vertex_count,
+                                                                   uint32_t* out_index_count);
+
+/* Copies the body mesh of the last update into caller buffers. Each of positions, normals
+ * (vertex_capacity entries) and indices (index_capacity entries; counter-clockwise seen from
+ * outside, 3 per triangle) may be NULL to skip it; at least one must be given. A non-NULL buffer
+ * whose capacity is below the size query's answer fails with DRAPE_ERROR_BUFFER_TOO_SMALL and
+ * nothing is written. DRAPE_ERROR_CALL_ORDER before the first successful update for positions
+ * and normals (indices are available at once). */
+DRAPE_API drape_result DRAPE_CALL drape_context_read_body_mesh(drape_context* context,
+                                                               drape_vec3* positions,
+                                                               drape_vec3* normals,
+                                                               uint32_t vertex_capacity,
+                                                               uint32_t* indices,
+                                                               uint32_t index_capacity);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Statistics                                                                                  */
+/* ------------------------------------------------------------------------------------------ */
+
+typedef struct drape_frame_stats {
+  uint32_t struct_size;       /* caller sets sizeof(drape_frame_stats) */
+  uint32_t frames_pushed;     /* push calls (accepted + rejected) */
+  uint32_t frames_accepted;
+  uint32_t frames_rejected;
+  uint32_t frames_dropped;    /* accepted but replaced before an update consumed them */
+  uint32_t updates;           /* updates that consumed a new frame */
+  uint32_t teleports;         /* teleports detected so far */
+  uint8_t teleported;         /* 1 if the last update's frame was a teleport */
+  uint8_t calibrated;         /* 1 once bone lengths are frozen */
+  uint8_t reserved0, reserved1;
+  double last_timestamp_s;    /* of the last accepted frame */
+  double skeleton_ms;         /* wall time of the last update's skeleton stage */
+  double body_ms;             /* wall time of the last update's ring + mesh stage */
+  float body_volume_l;        /* enclosed volume of the body mesh after the last update */
+  float reserved2;
+} drape_frame_stats;
+
+DRAPE_API drape_result DRAPE_CALL drape_context_get_frame_stats(drape_context* context,
+                                                                drape_frame_stats* out_stats);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Recordings                                                                                  */
+/* ------------------------------------------------------------------------------------------ */
+
+typedef struct drape_recording drape_recording;
+
+typedef enum drape_recording_format {
+  DRAPE_RECORDING_UNKNOWN = 0,
+  DRAPE_RECORDING_KINECT_CSV = 1, /* timestamp ticks + N x (x, y, z, state), as KinectReader */
+  DRAPE_RECORDING_BVH = 2,        /* BVH, joints by forward kinematics, mapped to Kinect v2 */
+  DRAPE_RECORDING_DRAPE = 3,      /* Drape's own text format (docs/recording-format.md) */
+  DRAPE_RECORDING_FORCE32 = 0x7fffffff
+} drape_recording_format;
+
+typedef struct drape_recording_info {
+  uint32_t struct_size;  /* caller sets sizeof(drape_recording_info) */
+  int32_t format;        /* drape_recording_format, detected from the content */
+  int32_t layout;        /* drape_layout of the frames */
+  uint32_t joint_count;
+  uint32_t frame_count;
+  float nominal_rate_hz; /* median frame rate */
+  double duration_s;
+} drape_recording_info;
+
+/* Reads a whole recording file. layout: DRAPE_LAYOUT_AUTO, or the layout the file must have (an
+ * error if it contradicts the content). On success the caller owns *out_recording and releases it
+ * with drape_recording_destroy. Any thread. */
+DRAPE_API drape_result DRAPE_CALL drape_recording_open(const char* path, int32_t layout,
+                                                       drape_recording** out_recording);
+/* Same from memory (the bytes are copied; the caller keeps ownership of `data`). */
+DRAPE_API drape_result DRAPE_CALL drape_recording_open_memory(const void* data, size_t size,
+                                                              int32_t layout,
+                                                              drape_recording** out_recording);
+/* NULL is accepted and ignored. One thread per recording. */
+DRAPE_API drape_result DRAPE_CALL drape_recording_destroy(drape_recording* recording);
+DRAPE_API drape_result DRAPE_CALL drape_recording_get_info(drape_recording* recording,
+                                                           drape_recording_info* out_info);
+/* Copies frame `index` (0-based) into joints (capacity >= joint_count). out_timestamp_s may be
+ * NULL. Recording timestamps start at 0. */
+DRAPE_API drape_result DRAPE_CALL drape_recording_read_frame(drape_recording* recording,
+                                                             uint32_t index, drape_joint* joints,
+                                                             uint32_t capacity,
+                                                             double* out_timestamp_s);
+/* Writes the recording in Drape's own format to `path`. */
+DRAPE_API drape_result DRAPE_CALL drape_recording_save(drape_recording* recording,
+                                                       const char* path);
+
+#ifdef __cplusplus
+} /* extern "C" */
+#endif
+
+#endif /* DRAPE_H */

@@ -1,0 +1,107 @@
+// The body: elliptical feature rings placed along the skeleton's bones (paper §2.1), joined into
+// one closed, consistently wound triangle mesh, with the dynamic shoulder junction (paper §2.2).
+//
+// Layout, chosen for the stages that follow (tracking ellipsoids, cloth, OpenCL):
+//  - rings are stored flat (structure of arrays: centre, frame, semi-axes) in chain order, so the
+//    ellipsoid stage reads them without walking any tree;
+//  - the mesh topology (indices) is fixed when the model is built — it depends only on K and the
+//    ring density — and every frame rewrites positions and normals in place, without allocating.
+#pragma once
+
+#include "body/body_shape.h"
+#include "common/math.h"
+#include "skeleton/joints.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace drape {
+
+// A chain is a run of bones the rings follow without branching.
+enum class Chain : int { Torso = 0, Head, ArmL, ArmR, LegL, LegR, Count };
+constexpr int kChainCount = static_cast<int>(Chain::Count);
+const char* chainName(Chain c);
+
+// Where a ring sits and how big it is. `u` runs along the chain: bone k of the chain covers
+// u in [k, k+1] (0 = the chain's first joint); `offset_m` slides the ring further along the
+// local bone direction (for rings beyond the last joint, e.g. the top of the head).
+struct RingStation {
+  Chain chain = Chain::Torso;
+  float u = 0.0f;
+  float offset_m = 0.0f;
+  float forward_m = 0.0f;  // semi-axis along the ring frame's x (body forward)
+  float side_m = 0.0f;     // semi-axis along the ring frame's z (body right / limb side)
+  int measure = -1;        // Measure whose girth this ring reproduces exactly, or -1
+  bool junction = false;   // the dynamic shoulder ring (radius follows the next ring)
+};
+
+struct BodyModelParams {
+  int ring_points = 20;           // K: a multiple of 4 in [8, 256]
+  int rings_per_segment = 1;      // extra rings interpolated between two stations: [0, 16]
+  // The paper's naive fixed shoulder connection ring (normal = the rest arm direction) instead of
+  // the dynamic junction; exists only so tests can show what the dynamic junction prevents.
+  bool fixed_shoulder_junction = false;
+};
+
+// One ring's pose this frame. The frame is a proper rotation: x = forward, y = along the chain,
+// z = x × y. (The paper writes z = body left, which makes its frame left-handed; an ellipse is
+// symmetric about its x axis so the geometry is the same, and we keep det(R) = +1.)
+struct RingPose {
+  Vec3 centre = Vec3::Zero();
+  Mat3 frame = Mat3::Identity();  // columns x, y, z
+  float forward_m = 0.0f;
+  float side_m = 0.0f;
+};
+
+class BodyModel {
+ public:
+  // Builds rings and the fixed topology. Params must be valid (checked by the caller).
+  BodyModel(const ResolvedShape& shape, const BodyModelParams& params);
+
+  // Replaces the shape; topology is unchanged (it does not depend on the shape).
+  void setShape(const ResolvedShape& shape);
+
+  // Places every ring on the pose and rewrites positions and normals. No allocation.
+  void update(const SkeletonPose& pose);
+
+  const std::vector<RingStation>& stations() const { return stations_; }
+  const std::vector<RingPose>& rings() const { return rings_; }
+  // First ring index and ring count of each chain inside rings().
+  int chainFirstRing(Chain c) const { return chainFirst_[static_cast<int>(c)]; }
+  int chainRingCount(Chain c) const { return chainCount_[static_cast<int>(c)]; }
+  int ringPoints() const { return K_; }
+
+  const std::vector<Vec3>& positions() const { return positions_; }
+  const std::vector<Vec3>& normals() const { return normals_; }
+  const std::vector<uint32_t>& indices() const { return indices_; }
+  // Triangles of the stitch between a shoulder's torso loop and its junction ring (for tests).
+  const std::vector<uint32_t>& shoulderTriangles(bool left) const {
+    return left ? shoulderTrisL_ : shoulderTrisR_;
+  }
+  const ResolvedShape& shape() const { return shape_; }
+
+ private:
+  void buildStations();
+  void buildTopology();
+  void placeRings(const SkeletonPose& pose);
+  void writeVertices(const SkeletonPose& pose);
+  void computeNormals();
+
+  ResolvedShape shape_;
+  BodyModelParams params_;
+  int K_ = 20;
+  std::vector<RingStation> stations_;  // one per ring (interpolated ones included)
+  std::vector<RingPose> rings_;
+  int chainFirst_[kChainCount] = {};
+  int chainCount_[kChainCount] = {};
+
+  // Extra vertices after the ring points: crotch bridge, then one apex per chain end.
+  int bridgeFirst_ = 0, bridgeCount_ = 0;
+  int apexFirst_ = 0;  // Head, ArmL, ArmR, LegL, LegR
+
+  std::vector<Vec3> positions_, normals_;
+  std::vector<uint32_t> indices_;
+  std::vector<uint32_t> shoulderTrisL_, shoulderTrisR_;
+};
+
+}  // namespace drape

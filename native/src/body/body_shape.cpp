@@ -1,0 +1,114 @@
+#include "body/body_shape.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace drape {
+
+bool validateShapeInput(const BodyShapeInput& in, std::string& err) {
+  auto bad = [&](const char* what, float v, const char* range) {
+    std::ostringstream s;
+    s << "body shape: " << what << " = " << v << " is outside " << range;
+    err = s.str();
+    return false;
+  };
+  if (!std::isfinite(in.height_m) || !std::isfinite(in.weight_kg)) {
+    err = "body shape: height and weight must be finite numbers";
+    return false;
+  }
+  if (in.height_m < 0.8f || in.height_m > 2.5f) return bad("height_m", in.height_m, "[0.8, 2.5]");
+  if (in.weight_kg < 15.0f || in.weight_kg > 300.0f) return bad("weight_kg", in.weight_kg, "[15, 300]");
+  for (int i = 0; i < kGirthCount; ++i) {
+    const float g = in.girth_mm[i];
+    if (!std::isfinite(g)) {
+      err = std::string("body shape: ") + measureName(static_cast<Measure>(i)) + "_mm is not finite";
+      return false;
+    }
+    if (g != 0.0f && (g < 50.0f || g > 3000.0f)) {
+      const std::string name = std::string(measureName(static_cast<Measure>(i))) + "_mm";
+      return bad(name.c_str(), g, "0 (predict) or [50, 3000]");
+    }
+  }
+  const int sex = static_cast<int>(in.sex);
+  if (sex < 0 || sex > 2) {
+    err = "body shape: sex must be 0 (unspecified), 1 (female) or 2 (male)";
+    return false;
+  }
+  return true;
+}
+
+ResolvedShape resolveShape(const BodyShapeInput& in) {
+  ResolvedShape r;
+  r.input = in;
+  for (int i = 0; i < static_cast<int>(Measure::Count); ++i) {
+    r.m[i] = 0.001f * predictMeasureMm(static_cast<Measure>(i), in.height_m, in.weight_kg);
+  }
+  // Girths the host gave replace predictions; the breadths/depths that describe the same cross
+  // section scale with them so the ellipse keeps its predicted proportions.
+  auto scalePair = [&](Measure girth, Measure a, Measure b) {
+    const int g = static_cast<int>(girth);
+    if (in.girth_mm[g] <= 0.0f) return;
+    const float factor = 0.001f * in.girth_mm[g] / r.m[g];
+    r.m[static_cast<int>(a)] *= factor;
+    r.m[static_cast<int>(b)] *= factor;
+  };
+  scalePair(Measure::Chest, Measure::ChestDepth, Measure::ChestBreadth);
+  scalePair(Measure::Waist, Measure::WaistDepth, Measure::WaistBreadth);
+  scalePair(Measure::Hip, Measure::ButtockDepth, Measure::HipBreadth);
+  for (int i = 0; i < kGirthCount; ++i) {
+    r.girth_given[i] = in.girth_mm[i] > 0.0f;
+    if (r.girth_given[i]) r.m[i] = 0.001f * in.girth_mm[i];
+  }
+  return r;
+}
+
+SkeletonPose restPose(const ResolvedShape& shape, float arm_down_deg) {
+  constexpr float kRestDepth = 2.5f;  // metres in front of the sensor
+  // Heights as fractions of stature (Winter fig. 4.1 / Drillis & Contini), placed where the
+  // Kinect v2 tracker puts its joints (joint centres, not surface landmarks).
+  const float H = shape.input.height_m;
+  SkeletonPose p;
+  auto at = [&](Joint j, float x, float y_frac) {
+    p.position[idx(j)] = Vec3(x, y_frac * H, kRestDepth);
+    p.state[idx(j)] = TrackingState::Tracked;
+  };
+  // Facing -Z (towards a sensor at the origin looking along +Z): the subject's right is +X.
+  const float pelvisY = 0.530f;
+  at(Joint::Pelvis, 0.0f, pelvisY);
+  at(Joint::SpineMid, 0.0f, 0.650f);
+  at(Joint::SpineShoulder, 0.0f, 0.818f);
+  at(Joint::Neck, 0.0f, 0.870f);
+  at(Joint::Head, 0.0f, 0.935f);
+  const float shoulderHalf = 0.100f;  // shoulder joint centres sit ~0.10 H from the midline
+  const float hipHalf = 0.052f;       // hip joint centres ~0.052 H from the midline
+  at(Joint::HipL, -hipHalf * H, pelvisY - 0.01f);
+  at(Joint::HipR, +hipHalf * H, pelvisY - 0.01f);
+  at(Joint::KneeL, -hipHalf * H, 0.285f);
+  at(Joint::KneeR, +hipHalf * H, 0.285f);
+  at(Joint::AnkleL, -hipHalf * H, 0.039f);
+  at(Joint::AnkleR, +hipHalf * H, 0.039f);
+  at(Joint::FootL, -hipHalf * H, 0.015f);
+  at(Joint::FootR, +hipHalf * H, 0.015f);
+  p.position[idx(Joint::FootL)].z() = kRestDepth - 0.10f * H;  // toes point forward (-Z)
+  p.position[idx(Joint::FootR)].z() = kRestDepth - 0.10f * H;
+  at(Joint::ShoulderL, -shoulderHalf * H, 0.808f);
+  at(Joint::ShoulderR, +shoulderHalf * H, 0.808f);
+  // Arm segment lengths: upper arm 0.186 H, forearm 0.146 H, wrist to hand centre 0.06 H.
+  const float a = arm_down_deg * kPi / 180.0f;
+  const float lengths[3] = {0.186f * H, 0.146f * H, 0.060f * H};
+  for (int side = 0; side < 2; ++side) {
+    const float sx = side == 0 ? -1.0f : 1.0f;
+    const Vec3 dir(sx * std::cos(a), -std::sin(a), 0.0f);
+    const Joint chain[4] = {side == 0 ? Joint::ShoulderL : Joint::ShoulderR,
+                            side == 0 ? Joint::ElbowL : Joint::ElbowR,
+                            side == 0 ? Joint::WristL : Joint::WristR,
+                            side == 0 ? Joint::HandL : Joint::HandR};
+    for (int k = 1; k < 4; ++k) {
+      p.position[idx(chain[k])] = p.position[idx(chain[k - 1])] + dir * lengths[k - 1];
+      p.state[idx(chain[k])] = TrackingState::Tracked;
+    }
+  }
+  return p;
+}
+
+}  // namespace drape

@@ -1,0 +1,46 @@
+// Body shape: what the host tells us about the person (height, weight, optional girths) resolved
+// into every measurement the ring template needs, with the missing ones predicted from the ANSUR II
+// regression (girth_regression.h).
+#pragma once
+
+#include "body/girth_regression.h"
+#include "skeleton/joints.h"
+
+#include <array>
+#include <string>
+
+namespace drape {
+
+enum class Sex : int { Unspecified = 0, Female = 1, Male = 2 };
+
+// Input: as the C ABI's drape_body_shape (girths in mm, 0 = predict).
+struct BodyShapeInput {
+  Sex sex = Sex::Unspecified;
+  float height_m = 1.70f;
+  float weight_kg = 65.0f;
+  std::array<float, kGirthCount> girth_mm{};  // Measure order: neck, chest, waist, hip, thigh, calf, upper_arm, forearm
+};
+
+// Every measurement resolved, in metres.
+struct ResolvedShape {
+  BodyShapeInput input;                           // as given (girths 0 where predicted)
+  std::array<float, static_cast<int>(Measure::Count)> m{};  // metres, indexed by Measure
+  std::array<bool, kGirthCount> girth_given{};
+
+  float operator[](Measure which) const { return m[static_cast<int>(which)]; }
+};
+
+// Validates ranges (height 0.8..2.5 m, weight 15..300 kg, girths 0 or 50..3000 mm, finite).
+bool validateShapeInput(const BodyShapeInput& in, std::string& err);
+
+// Fills every measurement: given girths as given, the rest predicted. Predicted breadths/depths
+// are rescaled so the depth:breadth ratio follows the girth actually used.
+ResolvedShape resolveShape(const BodyShapeInput& in);
+
+// A standing rest pose (arms 35 degrees below horizontal, facing -Z in a Kinect-style camera
+// space with +Y up, feet at y = 0, 2.5 m in front of the sensor) with segment lengths from standard anthropometric
+// proportions of stature (Winter, "Biomechanics and Motor Control of Human Movement", fig. 4.1).
+// Used to fix the mesh topology's seam alignment and for synthetic tests.
+SkeletonPose restPose(const ResolvedShape& shape, float arm_down_deg = 35.0f);
+
+}  // namespace drape
