@@ -1,0 +1,256 @@
+// C entry points for contexts: creation, body shape, skeleton input, update and reads.
+#include "capi/api_support.h"
+#include "capi/context.h"
+
+#include <algorithm>
+#include <cstring>
+
+using drape::Context;
+using namespace drape::api;
+
+namespace {
+
+Context* asContext(drape_context* handle) { return reinterpret_cast<Context*>(handle); }
+
+#define DRAPE_CHECK_CONTEXT(fn, handle)                                                        \
+  do {                                                                                         \
+    if (!(handle)) return fail(DRAPE_ERROR_NULL_ARGUMENT, fn ": context is NULL");             \
+    if (!isLiveHandle(HandleKind::Context, handle))                                            \
+      return fail(DRAPE_ERROR_INVALID_HANDLE, fn ": context is not a live drape_context (destroyed or never created)"); \
+  } while (0)
+
+drape_result toShapeInput(const drape_body_shape& s, drape::BodyShapeInput& in) {
+  in.sex = static_cast<drape::Sex>(s.sex);
+  if (s.sex < DRAPE_SEX_UNSPECIFIED || s.sex > DRAPE_SEX_MALE)
+    return fail(DRAPE_ERROR_OUT_OF_RANGE, "body shape: sex must be 0 (unspecified), 1 (female) or 2 (male)");
+  in.height_m = s.height_m;
+  in.weight_kg = s.weight_kg;
+  const float g[drape::kGirthCount] = {s.neck_mm, s.chest_mm, s.waist_mm, s.hip_mm,
+                                       s.thigh_mm, s.calf_mm, s.upper_arm_mm, s.forearm_mm};
+  std::copy(g, g + drape::kGirthCount, in.girth_mm.begin());
+  return DRAPE_OK;
+}
+
+}  // namespace
+
+extern "C" {
+
+DRAPE_API drape_result DRAPE_CALL drape_context_desc_init(drape_context_desc* desc) {
+  if (!desc) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_desc_init: desc is NULL");
+  std::memset(desc, 0, sizeof(*desc));
+  const drape::TrackerParams t;
+  desc->struct_size = sizeof(drape_context_desc);
+  desc->ring_points = 20;
+  desc->rings_per_segment = 1;
+  desc->calibration_frames = static_cast<uint32_t>(t.calibration_frames);
+  desc->filter = DRAPE_FILTER_ONE_EURO;
+  desc->filter_min_cutoff_hz = t.min_cutoff_hz;
+  desc->filter_beta = t.beta;
+  desc->filter_d_cutoff_hz = t.d_cutoff_hz;
+  desc->smoothing = t.smoothing;
+  desc->correction = t.correction;
+  desc->prediction = t.prediction;
+  desc->jitter_radius_m = t.jitter_radius_m;
+  desc->max_deviation_m = t.max_deviation_m;
+  desc->teleport_distance_m = t.teleport_distance_m;
+  return DRAPE_OK;
+}
+
+DRAPE_API drape_result DRAPE_CALL drape_context_create(const drape_context_desc* desc,
+                                                       drape_context** out_context) {
+  return guarded("drape_context_create", [&]() -> drape_result {
+    if (!out_context) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_create: out_context is NULL");
+    drape_context_desc d;
+    drape_context_desc_init(&d);
+    if (desc) {
+      if (drape_result r = checkStructSize(desc->struct_size, sizeof(drape_context_desc), "drape_context_desc"))
+        return r;
+      d = *desc;
+      d.struct_size = sizeof(drape_context_desc);
+    }
+    std::string err;
+    if (drape_result r = drape::validateContextDesc(d, err)) return fail(r, "drape_context_create: " + err);
+    auto* ctx = new Context(d);
+    registerHandle(HandleKind::Context, ctx);
+    *out_context = reinterpret_cast<drape_context*>(ctx);
+    return DRAPE_OK;
+  });
+}
+
+DRAPE_API drape_result DRAPE_CALL drape_context_destroy(drape_context* context) {
+  return guarded("drape_context_destroy", [&]() -> drape_result {
+    if (!context) return DRAPE_OK;
+    if (!isLiveHandle(HandleKind::Context, context))
+      return fail(DRAPE_ERROR_INVALID_HANDLE, "drape_context_destroy: context is not a live drape_context");
+    unregisterHandle(HandleKind::Context, context);
+    delete asContext(context);
+    return DRAPE_OK;
+  });
+}
+
+DRAPE_API drape_result DRAPE_CALL drape_body_shape_init(drape_body_shape* shape) {
+  if (!shape) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_body_shape_init: shape is NULL");
+  std::memset(shape, 0, sizeof(*shape));
+  const drape::BodyShapeInput defaults;
+  shape->struct_size = sizeof(drape_body_shape);
+  shape->sex = DRAPE_SEX_UNSPECIFIED;
+  shape->height_m = defaults.height_m;
+  shape->weight_kg = defaults.weight_kg;
+  return DRAPE_OK;
+}
+
+DRAPE_API drape_result DRAPE_CALL drape_context_set_body_shape(drape_context* context,
+                                                               const drape_body_shape* shape) {
+  return guarded("drape_context_set_body_shape", [&]() -> drape_result {
+    DRAPE_CHECK_CONTEXT("drape_context_set_body_shape", context);
+    if (!shape) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_set_body_shape: shape is NULL");
+    if (drape_result r = checkStructSize(shape->struct_size, sizeof(drape_body_shape), "drape_body_shape")) return r;
+    drape::BodyShapeInput in;
+    if (drape_result r = toShapeInput(*shape, in)) return r;
+    std::string err;
+    if (drape_result r = asContext(context)->setShape(in, err)) return fail(r, "drape_context_set_body_shape: " + err);
+    return DRAPE_OK;
+  });
+}
+
+DRAPE_API drape_result DRAPE_CALL drape_context_get_body_shape(drape_context* context,
+                                                               drape_body_shape* out_shape) {
+  return guarded("drape_context_get_body_shape", [&]() -> drape_result {
+    DRAPE_CHECK_CONTEXT("drape_context_get_body_shape", context);
+    if (!out_shape) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_get_body_shape: out_shape is NULL");
+    if (drape_result r = checkStructSize(out_shape->struct_size, sizeof(drape_body_shape), "drape_body_shape")) return r;
+    const drape::ResolvedShape& s = asContext(context)->shape();
+    drape_body_shape o;
+    std::memset(&o, 0, sizeof(o));
+    o.struct_size = sizeof(drape_body_shape);
+    o.sex = static_cast<int32_t>(s.input.sex);
+    o.height_m = s.input.height_m;
+    o.weight_kg = s.input.weight_kg;
+    float* g[drape::kGirthCount] = {&o.neck_mm, &o.chest_mm, &o.waist_mm, &o.hip_mm,
+                                    &o.thigh_mm, &o.calf_mm, &o.upper_arm_mm, &o.forearm_mm};
+    for (int i = 0; i < drape::kGirthCount; ++i) *g[i] = 1000.0f * s.m[i];
+    *out_shape = o;
+    return DRAPE_OK;
+  });
+}
+
+DRAPE_API drape_result DRAPE_CALL drape_context_push_skeleton(drape_context* context,
+                                                              const drape_skeleton_frame* frame) {
+  return guarded("drape_context_push_skeleton", [&]() -> drape_result {
+    DRAPE_CHECK_CONTEXT("drape_context_push_skeleton", context);
+    if (!frame) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_push_skeleton: frame is NULL");
+    if (drape_result r = checkStructSize(frame->struct_size, sizeof(drape_skeleton_frame), "drape_skeleton_frame"))
+      return r;
+    std::string err;
+    if (drape_result r = asContext(context)->pushFrame(*frame, err))
+      return fail(r, "drape_context_push_skeleton: " + err);
+    return DRAPE_OK;
+  });
+}
+
+DRAPE_API drape_result DRAPE_CALL drape_context_update(drape_context* context) {
+  return guarded("drape_context_update", [&]() -> drape_result {
+    DRAPE_CHECK_CONTEXT("drape_context_update", context);
+    std::string err;
+    if (drape_result r = asContext(context)->update(err)) return fail(r, "drape_context_update: " + err);
+    return DRAPE_OK;
+  });
+}
+
+DRAPE_API drape_result DRAPE_CALL drape_context_read_skeleton(drape_context* context, drape_vec3* positions,
+                                                              uint32_t capacity, uint32_t* out_count) {
+  return guarded("drape_context_read_skeleton", [&]() -> drape_result {
+    DRAPE_CHECK_CONTEXT("drape_context_read_skeleton", context);
+    if (!positions) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_read_skeleton: positions is NULL");
+    if (capacity < static_cast<uint32_t>(drape::kJointCount))
+      return fail(DRAPE_ERROR_BUFFER_TOO_SMALL, "drape_context_read_skeleton: capacity " + std::to_string(capacity) +
+                                                    " is below 21 joints");
+    Context* ctx = asContext(context);
+    if (!ctx->hasUpdate())
+      return fail(DRAPE_ERROR_CALL_ORDER, "drape_context_read_skeleton: no update has run yet");
+    const auto& pose = ctx->tracker().pose();
+    for (int j = 0; j < drape::kJointCount; ++j)
+      positions[j] = drape_vec3{pose.position[j].x(), pose.position[j].y(), pose.position[j].z()};
+    if (out_count) *out_count = static_cast<uint32_t>(drape::kJointCount);
+    return DRAPE_OK;
+  });
+}
+
+DRAPE_API drape_result DRAPE_CALL drape_context_get_body_mesh_size(drape_context* context,
+                                                                   uint32_t* out_vertex_count,
+                                                                   uint32_t* out_index_count) {
+  return guarded("drape_context_get_body_mesh_size", [&]() -> drape_result {
+    DRAPE_CHECK_CONTEXT("drape_context_get_body_mesh_size", context);
+    if (!out_vertex_count && !out_index_count)
+      return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_get_body_mesh_size: both out pointers are NULL");
+    const drape::BodyModel& body = asContext(context)->body();
+    if (out_vertex_count) *out_vertex_count = static_cast<uint32_t>(body.positions().size());
+    if (out_index_count) *out_index_count = static_cast<uint32_t>(body.indices().size());
+    return DRAPE_OK;
+  });
+}
+
+DRAPE_API drape_result DRAPE_CALL drape_context_read_body_mesh(drape_context* context, drape_vec3* positions,
+                                                               drape_vec3* normals, uint32_t vertex_capacity,
+                                                               uint32_t* indices, uint32_t index_capacity) {
+  return guarded("drape_context_read_body_mesh", [&]() -> drape_result {
+    DRAPE_CHECK_CONTEXT("drape_context_read_body_mesh", context);
+    if (!positions && !normals && !indices)
+      return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_read_body_mesh: positions, normals and indices are all NULL");
+    Context* ctx = asContext(context);
+    const drape::BodyModel& body = ctx->body();
+    const size_t nv = body.positions().size(), ni = body.indices().size();
+    // Check everything before writing anything.
+    if ((positions || normals) && vertex_capacity < nv)
+      return fail(DRAPE_ERROR_BUFFER_TOO_SMALL, "drape_context_read_body_mesh: vertex_capacity " +
+                                                    std::to_string(vertex_capacity) + " < " + std::to_string(nv) + " vertices");
+    if (indices && index_capacity < ni)
+      return fail(DRAPE_ERROR_BUFFER_TOO_SMALL, "drape_context_read_body_mesh: index_capacity " +
+                                                    std::to_string(index_capacity) + " < " + std::to_string(ni) + " indices");
+    if ((positions || normals) && !ctx->hasUpdate())
+      return fail(DRAPE_ERROR_CALL_ORDER,
+                  "drape_context_read_body_mesh: positions and normals exist after the first successful update");
+    static_assert(sizeof(drape_vec3) == 3 * sizeof(float), "drape_vec3 must be three packed floats");
+    if (positions)
+      for (size_t i = 0; i < nv; ++i) {
+        const auto& p = body.positions()[i];
+        positions[i] = drape_vec3{p.x(), p.y(), p.z()};
+      }
+    if (normals)
+      for (size_t i = 0; i < nv; ++i) {
+        const auto& n = body.normals()[i];
+        normals[i] = drape_vec3{n.x(), n.y(), n.z()};
+      }
+    if (indices) std::copy(body.indices().begin(), body.indices().end(), indices);
+    return DRAPE_OK;
+  });
+}
+
+DRAPE_API drape_result DRAPE_CALL drape_context_get_frame_stats(drape_context* context,
+                                                                drape_frame_stats* out_stats) {
+  return guarded("drape_context_get_frame_stats", [&]() -> drape_result {
+    DRAPE_CHECK_CONTEXT("drape_context_get_frame_stats", context);
+    if (!out_stats) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_get_frame_stats: out_stats is NULL");
+    if (drape_result r = checkStructSize(out_stats->struct_size, sizeof(drape_frame_stats), "drape_frame_stats"))
+      return r;
+    drape_frame_stats s;
+    std::memset(&s, 0, sizeof(s));
+    s.struct_size = sizeof(drape_frame_stats);
+    asContext(context)->fillStats(s);
+    *out_stats = s;
+    return DRAPE_OK;
+  });
+}
+
+}  // extern "C"
+
+// Layout guarantees the C# bindings (and any other FFI) rely on.
+static_assert(sizeof(drape_vec3) == 12, "drape_vec3 layout");
+static_assert(sizeof(drape_quat) == 16, "drape_quat layout");
+static_assert(sizeof(drape_joint) == 16, "drape_joint layout");
+static_assert(sizeof(drape_context_desc) == 56, "drape_context_desc layout");
+static_assert(sizeof(drape_body_shape) == 48, "drape_body_shape layout");
+static_assert(sizeof(drape_skeleton_frame) == 40, "drape_skeleton_frame layout");
+static_assert(sizeof(drape_frame_stats) == 64, "drape_frame_stats layout");
+static_assert(sizeof(drape_recording_info) == 32, "drape_recording_info layout");
+static_assert(sizeof(drape_result) == 4, "enums are 32-bit");

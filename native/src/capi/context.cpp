@@ -1,0 +1,225 @@
+#include "capi/context.h"
+
+#include "body/mesh_metrics.h"
+#include "skeleton/layouts.h"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+namespace drape {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// Coordinates beyond this are not a person in front of a sensor; rejecting them keeps 1e30-style
+// garbage from turning into Inf inside the filters.
+constexpr float kMaxCoordinateM = 1000.0f;
+
+}  // namespace
+
+drape_result validateContextDesc(const drape_context_desc& d, std::string& err) {
+  std::ostringstream s;
+  auto range = [&](const char* name, double v, double lo, double hi) {
+    if (!std::isfinite(v)) {
+      s << "context desc: " << name << " is not finite";
+      return DRAPE_ERROR_NONFINITE;
+    }
+    if (v < lo || v > hi) {
+      s << "context desc: " << name << " = " << v << " is outside [" << lo << ", " << hi << "]";
+      return DRAPE_ERROR_OUT_OF_RANGE;
+    }
+    return DRAPE_OK;
+  };
+  drape_result r = DRAPE_OK;
+  if (d.ring_points < 8 || d.ring_points > 256 || d.ring_points % 4 != 0) {
+    s << "context desc: ring_points = " << d.ring_points << " must be a multiple of 4 in [8, 256]";
+    r = DRAPE_ERROR_OUT_OF_RANGE;
+  } else if ((r = range("rings_per_segment", d.rings_per_segment, 0, 16)) != DRAPE_OK) {
+  } else if ((r = range("calibration_frames", d.calibration_frames, 1, 100000)) != DRAPE_OK) {
+  } else if (d.filter < DRAPE_FILTER_NONE || d.filter > DRAPE_FILTER_DOUBLE_EXPONENTIAL) {
+    s << "context desc: filter = " << d.filter << " is not a drape_filter value (0, 1, 2)";
+    r = DRAPE_ERROR_OUT_OF_RANGE;
+  } else if ((r = range("filter_min_cutoff_hz", d.filter_min_cutoff_hz, 1e-3, 1000)) != DRAPE_OK) {
+  } else if ((r = range("filter_beta", d.filter_beta, 0, 1000)) != DRAPE_OK) {
+  } else if ((r = range("filter_d_cutoff_hz", d.filter_d_cutoff_hz, 1e-3, 1000)) != DRAPE_OK) {
+  } else if ((r = range("smoothing", d.smoothing, 0, 0.999)) != DRAPE_OK) {
+  } else if ((r = range("correction", d.correction, 0, 1)) != DRAPE_OK) {
+  } else if ((r = range("prediction", d.prediction, 0, 10)) != DRAPE_OK) {
+  } else if ((r = range("jitter_radius_m", d.jitter_radius_m, 0, 10)) != DRAPE_OK) {
+  } else if ((r = range("max_deviation_m", d.max_deviation_m, 0, 10)) != DRAPE_OK) {
+  } else if ((r = range("teleport_distance_m", d.teleport_distance_m, 1e-6, 100)) != DRAPE_OK) {
+  }
+  err = s.str();
+  return r;
+}
+
+TrackerParams trackerParamsFrom(const drape_context_desc& d) {
+  TrackerParams p;
+  p.filter = static_cast<FilterKind>(d.filter);
+  p.min_cutoff_hz = d.filter_min_cutoff_hz;
+  p.beta = d.filter_beta;
+  p.d_cutoff_hz = d.filter_d_cutoff_hz;
+  p.smoothing = d.smoothing;
+  p.correction = d.correction;
+  p.prediction = d.prediction;
+  p.jitter_radius_m = d.jitter_radius_m;
+  p.max_deviation_m = d.max_deviation_m;
+  p.calibration_frames = static_cast<int>(d.calibration_frames);
+  p.teleport_distance_m = d.teleport_distance_m;
+  return p;
+}
+
+Context::Context(const drape_context_desc& desc)
+    : desc_(desc), shape_(resolveShape(BodyShapeInput{})), tracker_(trackerParamsFrom(desc)) {
+  BodyModelParams bp;
+  bp.ring_points = static_cast<int>(desc.ring_points);
+  bp.rings_per_segment = static_cast<int>(desc.rings_per_segment);
+  body_ = std::make_unique<BodyModel>(shape_, bp);
+  orientations_.reserve(32);
+}
+
+drape_result Context::setShape(const BodyShapeInput& in, std::string& err) {
+  if (!validateShapeInput(in, err)) {
+    const bool nonfinite = err.find("finite") != std::string::npos;
+    return nonfinite ? DRAPE_ERROR_NONFINITE : DRAPE_ERROR_OUT_OF_RANGE;
+  }
+  shape_ = resolveShape(in);
+  body_->setShape(shape_);
+  shapeDirty_ = true;
+  volumeDirty_ = true;
+  return DRAPE_OK;
+}
+
+drape_result Context::pushFrame(const drape_skeleton_frame& f, std::string& err) {
+  ++pushed_;
+  auto reject = [&](drape_result r, const std::string& message) {
+    ++rejected_;
+    err = message;
+    return r;
+  };
+  if (f.layout < DRAPE_LAYOUT_KINECT1 || f.layout > DRAPE_LAYOUT_AZURE)
+    return reject(DRAPE_ERROR_OUT_OF_RANGE, "skeleton frame: layout " + std::to_string(f.layout) +
+                                                " is not 1 (Kinect v1), 2 (Kinect v2) or 3 (Azure Kinect)");
+  const Layout layout = static_cast<Layout>(f.layout);
+  const int expected = layoutJointCount(layout);
+  if (f.joint_count != static_cast<uint32_t>(expected))
+    return reject(DRAPE_ERROR_INVALID_ARGUMENT,
+                  "skeleton frame: joint_count " + std::to_string(f.joint_count) + " does not match layout " +
+                      std::to_string(f.layout) + " (" + std::to_string(expected) + " joints)");
+  if (!f.joints) return reject(DRAPE_ERROR_NULL_ARGUMENT, "skeleton frame: joints is NULL");
+  if (!std::isfinite(f.timestamp_s))
+    return reject(DRAPE_ERROR_NONFINITE, "skeleton frame: timestamp_s is not finite");
+  if (hasAccepted_ && !(f.timestamp_s > lastAcceptedTime_)) {
+    std::ostringstream s;
+    s.precision(17);
+    s << "skeleton frame: timestamp " << f.timestamp_s << " s is not after the previous frame's "
+      << lastAcceptedTime_ << " s";
+    return reject(DRAPE_ERROR_TIMESTAMP, s.str());
+  }
+  JointSample samples[32];
+  for (int j = 0; j < expected; ++j) {
+    const drape_joint& in = f.joints[j];
+    const float c[3] = {in.position.x, in.position.y, in.position.z};
+    for (float v : c) {
+      if (!std::isfinite(v))
+        return reject(DRAPE_ERROR_NONFINITE, "skeleton frame: joint " + std::to_string(j) + " has a NaN or Inf coordinate");
+      if (std::fabs(v) > kMaxCoordinateM)
+        return reject(DRAPE_ERROR_OUT_OF_RANGE, "skeleton frame: joint " + std::to_string(j) +
+                                                    " is more than 1000 m from the sensor");
+    }
+    if (in.tracking_state < DRAPE_TRACKING_NOT_TRACKED || in.tracking_state > DRAPE_TRACKING_TRACKED)
+      return reject(DRAPE_ERROR_OUT_OF_RANGE, "skeleton frame: joint " + std::to_string(j) + " tracking_state " +
+                                                  std::to_string(in.tracking_state) + " is not 0, 1 or 2");
+    samples[j].position = Vec3(c[0], c[1], c[2]);
+    samples[j].state = static_cast<TrackingState>(in.tracking_state);
+  }
+  if (f.orientations) {
+    for (int j = 0; j < expected; ++j) {
+      const drape_quat& q = f.orientations[j];
+      const float n2 = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w;
+      if (!std::isfinite(n2))
+        return reject(DRAPE_ERROR_NONFINITE, "skeleton frame: orientation " + std::to_string(j) + " is not finite");
+      if (std::fabs(n2 - 1.0f) > 0.02f)
+        return reject(DRAPE_ERROR_INVALID_ARGUMENT, "skeleton frame: orientation " + std::to_string(j) +
+                                                        " is not a unit quaternion");
+    }
+  }
+  SkeletonPose pose;
+  std::string mapErr;
+  if (!mapToCanonical(layout, samples, expected, pose, mapErr))
+    return reject(DRAPE_ERROR_INVALID_ARGUMENT, "skeleton frame: " + mapErr);
+
+  // Accepted: commit.
+  if (hasQueued_) ++dropped_;
+  queued_ = pose;
+  queuedTime_ = f.timestamp_s;
+  hasQueued_ = true;
+  hasAccepted_ = true;
+  lastAcceptedTime_ = f.timestamp_s;
+  orientations_.assign(f.orientations ? f.orientations : nullptr,
+                       f.orientations ? f.orientations + expected : nullptr);
+  ++accepted_;
+  return DRAPE_OK;
+}
+
+drape_result Context::update(std::string& err) {
+  if (!hasQueued_ && !updated_) {
+    err = "update: no skeleton frame has been pushed yet (call drape_context_push_skeleton first)";
+    return DRAPE_ERROR_CALL_ORDER;
+  }
+  if (hasQueued_) {
+    const auto t0 = Clock::now();
+    tracker_.push(queued_, queuedTime_);
+    hasQueued_ = false;
+    skeletonMs_ = msSince(t0);
+    teleported_ = tracker_.teleportedLastPush();
+    ++updates_;
+  } else if (!shapeDirty_) {
+    return DRAPE_OK;  // nothing new
+  }
+  const SkeletonPose& pose = tracker_.pose();
+  for (const Vec3& p : pose.position) {
+    if (!isFinite(p)) {
+      // Cannot happen with validated input; if it does, start the tracker afresh rather than
+      // spreading NaN into the body.
+      tracker_.reset();
+      err = "update: the skeleton filter produced a non-finite joint; tracker reset (please report)";
+      return DRAPE_ERROR_INTERNAL;
+    }
+  }
+  const auto t1 = Clock::now();
+  body_->update(pose);
+  bodyMs_ = msSince(t1);
+  updated_ = true;
+  shapeDirty_ = false;
+  volumeDirty_ = true;
+  return DRAPE_OK;
+}
+
+void Context::fillStats(drape_frame_stats& out) {
+  if (updated_ && volumeDirty_) {
+    volumeL_ = static_cast<float>(1000.0 * signedVolume(body_->positions(), body_->indices()));
+    volumeDirty_ = false;
+  }
+  out.frames_pushed = pushed_;
+  out.frames_accepted = accepted_;
+  out.frames_rejected = rejected_;
+  out.frames_dropped = dropped_;
+  out.updates = updates_;
+  out.teleports = tracker_.teleportCount();
+  out.teleported = teleported_ ? 1 : 0;
+  out.calibrated = tracker_.calibrated() ? 1 : 0;
+  out.reserved0 = out.reserved1 = 0;
+  out.last_timestamp_s = lastAcceptedTime_;
+  out.skeleton_ms = skeletonMs_;
+  out.body_ms = bodyMs_;
+  out.body_volume_l = updated_ ? volumeL_ : 0.0f;
+  out.reserved2 = 0.0f;
+}
+
+}  // namespace drape

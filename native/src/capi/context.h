@@ -1,0 +1,61 @@
+// The object behind a drape_context handle: one tracked person, their body, and the state the
+// C ABI promises to keep intact when a call is rejected.
+#pragma once
+
+#include "body/body_model.h"
+#include "body/body_shape.h"
+#include "drape/drape.h"
+#include "skeleton/tracker.h"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace drape {
+
+class Context {
+ public:
+  // Throws only std::bad_alloc (caught at the ABI). desc must be validated already.
+  explicit Context(const drape_context_desc& desc);
+
+  const drape_context_desc& desc() const { return desc_; }
+
+  // Each returns DRAPE_OK or an error with `err` filled; on error nothing changes except the
+  // rejected-frame counter.
+  drape_result setShape(const BodyShapeInput& in, std::string& err);
+  drape_result pushFrame(const drape_skeleton_frame& frame, std::string& err);
+  drape_result update(std::string& err);
+
+  const ResolvedShape& shape() const { return shape_; }
+  const BodyModel& body() const { return *body_; }
+  const SkeletonTracker& tracker() const { return tracker_; }
+  bool hasUpdate() const { return updated_; }
+  void fillStats(drape_frame_stats& out);
+
+ private:
+  drape_context_desc desc_;
+  ResolvedShape shape_;
+  SkeletonTracker tracker_;
+  std::unique_ptr<BodyModel> body_;
+
+  SkeletonPose queued_{};
+  double queuedTime_ = 0.0;
+  bool hasQueued_ = false;
+  std::vector<drape_quat> orientations_;  // of the last accepted frame, kept for the host
+  bool hasAccepted_ = false;
+  double lastAcceptedTime_ = 0.0;
+  bool updated_ = false;
+  bool shapeDirty_ = false;
+
+  uint32_t pushed_ = 0, accepted_ = 0, rejected_ = 0, dropped_ = 0, updates_ = 0;
+  bool teleported_ = false;
+  double skeletonMs_ = 0.0, bodyMs_ = 0.0;
+  float volumeL_ = 0.0f;
+  bool volumeDirty_ = true;
+};
+
+// Validates a context desc (ranges documented in drape.h). Returns DRAPE_OK or an error + message.
+drape_result validateContextDesc(const drape_context_desc& d, std::string& err);
+TrackerParams trackerParamsFrom(const drape_context_desc& d);
+
+}  // namespace drape
