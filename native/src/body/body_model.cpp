@@ -125,8 +125,9 @@ void BodyModel::buildStations() {
 
   // Neck and head: SpineShoulder (u=0) -> Neck (u=1) -> Head (u=2, centre of the head).
   const float headR = head / (2.0f * kPi);
-  add(Chain::Head, 0.30f, 0.0f, neck, 0.9f, static_cast<int>(Measure::Neck));  // ring N
-  add(Chain::Head, 1.00f, 0.0f, 0.92f * neck, 0.95f);
+  // ANSUR's neck girth is taken mid-neck (below the larynx); the base of the neck is ~12 % larger.
+  add(Chain::Head, 0.30f, 0.0f, 1.12f * neck, 0.9f);  // ring N
+  add(Chain::Head, 1.00f, 0.0f, neck, 0.95f, static_cast<int>(Measure::Neck));
   add(Chain::Head, 2.00f, -0.70f * headR, 0.78f * head, 1.1f);
   add(Chain::Head, 2.00f, -0.35f * headR, 0.95f * head, 1.2f);
   add(Chain::Head, 2.00f, 0.00f, head, 1.2f);
