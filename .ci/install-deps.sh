@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Installs the Debian packages Drape builds and tests with, only those that are missing.
+# Usage: bash .ci/install-deps.sh [--runtime-only]
+#   --runtime-only: just what building and running the samples needs (no test frameworks).
+set -euo pipefail
+
+packages=(cmake g++ make libeigen3-dev ocl-icd-opencl-dev opencl-headers pocl-opencl-icd)
+if [[ "${1:-}" != "--runtime-only" ]]; then
+  packages+=(googletest libgtest-dev libbenchmark-dev)
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")
+done
+
+if ((${#missing[@]})); then
+  echo "drape: installing Debian packages: ${missing[*]}"
+  SUDO=""
+  if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+if ! command -v dotnet >/dev/null 2>&1 && [[ "${1:-}" != "--runtime-only" ]]; then
+  echo "drape: the .NET SDK (dotnet) is required for the C# tests and is not on PATH" >&2
+  exit 1
+fi
