@@ -1,0 +1,273 @@
+// drape-replay: replays a skeleton recording through Drape's public C ABI (drape.h only, linked
+// against the shared library like any user program), checks every body mesh (finite numbers,
+// watertight, enclosed volume), optionally writes one OBJ per frame and writes a stats JSON.
+// Usage and the stats schema: docs/replay.md.
+#include <drape/drape.h>
+
+#include "mesh_checks.h"
+#include "obj_writer.h"
+#include "options.h"
+#include "stats.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <system_error>
+#include <vector>
+
+namespace fs = std::filesystem;
+using replay::Options;
+using replay::ReplayStats;
+
+#ifndef DRAPE_REPLAY_DEFAULT_RECORDING
+#define DRAPE_REPLAY_DEFAULT_RECORDING ""
+#endif
+#ifndef DRAPE_REPLAY_INSTALLED_RECORDING
+#define DRAPE_REPLAY_INSTALLED_RECORDING ""
+#endif
+
+namespace {
+
+constexpr int kExitOk = 0;
+constexpr int kExitFailure = 1;
+constexpr int kExitUsage = 2;
+
+// The one-line error on stderr (newlines in library messages are flattened).
+int fail(int code, std::string message) {
+  for (char& c : message)
+    if (c == '\n' || c == '\r') c = ' ';
+  std::fprintf(stderr, "drape-replay: error: %s\n", message.c_str());
+  return code;
+}
+
+std::string libraryReason(drape_result r) {
+  const char* msg = drape_last_error();
+  std::string s = drape_result_name(r);
+  if (msg && *msg) s += std::string(": ") + msg;
+  return s;
+}
+
+struct RecordingDeleter {
+  void operator()(drape_recording* r) const { drape_recording_destroy(r); }
+};
+struct ContextDeleter {
+  void operator()(drape_context* c) const { drape_context_destroy(c); }
+};
+
+// The bundled recording: beside an installed binary first (relocatable install), else the
+// source-tree copy whose path the build compiled in.
+std::string bundledRecording(const char* argv0) {
+  const std::string installed_rel = DRAPE_REPLAY_INSTALLED_RECORDING;
+  if (!installed_rel.empty()) {
+    std::error_code ec;
+    fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+    if (ec && argv0) exe = fs::absolute(argv0, ec);
+    if (!ec && !exe.empty()) {
+      const fs::path candidate = (exe.parent_path() / installed_rel).lexically_normal();
+      if (fs::is_regular_file(candidate, ec)) return candidate.string();
+    }
+  }
+  return DRAPE_REPLAY_DEFAULT_RECORDING;
+}
+
+// Creates `dir` (and parents) if missing. Returns false with a message when it cannot.
+bool ensureDirectory(const fs::path& dir, std::string& error) {
+  if (dir.empty()) return true;
+  std::error_code ec;
+  if (fs::is_directory(dir, ec)) return true;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir)) {
+    error = "cannot create directory '" + dir.string() + "'" + (ec ? ": " + ec.message() : std::string()) +
+            "; choose a writable --out/--stats location";
+    return false;
+  }
+  return true;
+}
+
+bool isFatalLibraryError(drape_result r) {
+  return r == DRAPE_ERROR_INTERNAL || r == DRAPE_ERROR_OUT_OF_MEMORY || r == DRAPE_ERROR_INVALID_HANDLE ||
+         r == DRAPE_ERROR_NULL_ARGUMENT;
+}
+
+int run(int argc, char** argv) {
+  Options opt;
+  std::string error;
+  if (!replay::parseOptions(argc, argv, opt, error)) return fail(kExitUsage, error);
+  if (opt.help) {
+    std::fputs(replay::helpText().c_str(), stdout);
+    return kExitOk;
+  }
+  if ((drape_version() >> 22) != DRAPE_VERSION_MAJOR)
+    return fail(kExitFailure, std::string("the Drape library is version ") + drape_version_string() +
+                                  ", this program was built for major version " +
+                                  std::to_string(DRAPE_VERSION_MAJOR) + "; rebuild drape-replay");
+
+  // Recording.
+  std::string path = opt.recording;
+  if (path.empty()) {
+    path = bundledRecording(argc > 0 ? argv[0] : nullptr);
+    if (path.empty() || !fs::exists(path))
+      return fail(kExitUsage, "the bundled recording was not found (" + path +
+                                  "); pass --recording PATH to a Kinect v2 CSV, BVH or .drec file");
+  }
+  drape_recording* raw_rec = nullptr;
+  if (drape_result r = drape_recording_open(path.c_str(), opt.layout, &raw_rec)) {
+    // The library's message names the file.
+    if (r == DRAPE_ERROR_IO)
+      return fail(kExitUsage, "cannot read the recording (" + libraryReason(r) + "); check the --recording path");
+    return fail(isFatalLibraryError(r) ? kExitFailure : kExitUsage,
+                "cannot parse the recording (" + libraryReason(r) +
+                    "); pass a Kinect v2 CSV, BVH or .drec file, with --layout auto or the file's layout");
+  }
+  std::unique_ptr<drape_recording, RecordingDeleter> rec(raw_rec);
+  drape_recording_info info{};
+  info.struct_size = sizeof info;
+  if (drape_result r = drape_recording_get_info(rec.get(), &info))
+    return fail(kExitFailure, "drape_recording_get_info failed: " + libraryReason(r));
+  if (info.frame_count == 0)
+    return fail(kExitUsage, "recording '" + path + "' holds no frames; pass a recording with at least one frame");
+
+  // Context and body.
+  drape_context_desc desc;
+  drape_context_desc_init(&desc);
+  if (opt.ring_points != 0) desc.ring_points = opt.ring_points;
+  drape_context* raw_ctx = nullptr;
+  if (drape_result r = drape_context_create(&desc, &raw_ctx)) {
+    if (isFatalLibraryError(r)) return fail(kExitFailure, "drape_context_create failed: " + libraryReason(r));
+    return fail(kExitUsage, "--ring-points " + std::to_string(desc.ring_points) + " was refused (" +
+                                libraryReason(r) + "); use a multiple of 4 in [8, 256], e.g. 20");
+  }
+  std::unique_ptr<drape_context, ContextDeleter> ctx(raw_ctx);
+  if (opt.body_given) {
+    if (drape_result r = drape_context_set_body_shape(ctx.get(), &opt.shape)) {
+      if (isFatalLibraryError(r)) return fail(kExitFailure, "drape_context_set_body_shape failed: " + libraryReason(r));
+      return fail(kExitUsage, "--body was refused (" + libraryReason(r) +
+                                  "); height_m in [0.8, 2.5], weight_kg in [15, 300], girths 0 or [50, 3000] mm");
+    }
+  }
+
+  ReplayStats st;
+  st.drape_version = drape_version_string();
+  st.recording = path;
+  st.format = info.format;
+  st.layout = info.layout;
+  st.recording_frames = info.frame_count;
+  st.recording_rate_hz = info.nominal_rate_hz;
+  st.ring_points = desc.ring_points;
+  drape_body_shape_init(&st.shape);
+  if (drape_result r = drape_context_get_body_shape(ctx.get(), &st.shape))
+    return fail(kExitFailure, "drape_context_get_body_shape failed: " + libraryReason(r));
+
+  uint32_t vertex_count = 0, index_count = 0;
+  if (drape_result r = drape_context_get_body_mesh_size(ctx.get(), &vertex_count, &index_count))
+    return fail(kExitFailure, "drape_context_get_body_mesh_size failed: " + libraryReason(r));
+  st.vertices = vertex_count;
+  st.triangles = index_count / 3;
+
+  // Outputs: create directories before spending time on the replay.
+  const std::string stats_path = replay::resolveStatsPath(opt);
+  if (opt.write_obj && !ensureDirectory(opt.out_dir, error)) return fail(kExitUsage, error);
+  if (!stats_path.empty() && !ensureDirectory(fs::path(stats_path).parent_path(), error))
+    return fail(kExitUsage, error);
+
+  const uint32_t frames = opt.max_frames == 0 ? info.frame_count : std::min(opt.max_frames, info.frame_count);
+  std::vector<drape_joint> joints(info.joint_count);
+  std::vector<drape_vec3> positions(vertex_count), normals(vertex_count);
+  std::vector<uint32_t> indices(index_count);
+  st.ms_per_frame.reserve(frames);
+  st.skeleton_ms.reserve(frames);
+  st.body_ms.reserve(frames);
+  st.volume_l.reserve(frames);
+  constexpr uint32_t kMaxRejectionMessages = 5;
+
+  using Clock = std::chrono::steady_clock;
+  for (uint32_t i = 0; i < frames; ++i) {
+    double timestamp = 0.0;
+    if (drape_result r = drape_recording_read_frame(rec.get(), i, joints.data(),
+                                                    static_cast<uint32_t>(joints.size()), &timestamp))
+      return fail(kExitFailure, "drape_recording_read_frame(" + std::to_string(i) + ") failed: " + libraryReason(r));
+    drape_skeleton_frame frame{};
+    frame.struct_size = sizeof frame;
+    frame.layout = info.layout;
+    frame.joint_count = info.joint_count;
+    frame.reserved = 0;
+    frame.timestamp_s = timestamp;
+    frame.joints = joints.data();
+    frame.orientations = nullptr;
+    ++st.frames;
+
+    const Clock::time_point t0 = Clock::now();
+    if (drape_result r = drape_context_push_skeleton(ctx.get(), &frame)) {
+      if (isFatalLibraryError(r))
+        return fail(kExitFailure, "drape_context_push_skeleton failed on frame " + std::to_string(i) + ": " +
+                                      libraryReason(r));
+      if (!opt.quiet && st.rejected_frames < kMaxRejectionMessages)
+        std::fprintf(stderr, "drape-replay: frame %u rejected: %s%s\n", i, libraryReason(r).c_str(),
+                     st.rejected_frames + 1 == kMaxRejectionMessages ? " (further rejections not shown)" : "");
+      ++st.rejected_frames;
+      continue;
+    }
+    if (drape_result r = drape_context_update(ctx.get()))
+      return fail(kExitFailure, "drape_context_update failed on frame " + std::to_string(i) + ": " + libraryReason(r));
+    const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    st.ms_per_frame.push_back(ms);
+
+    drape_frame_stats fs_stats{};
+    fs_stats.struct_size = sizeof fs_stats;
+    if (drape_result r = drape_context_get_frame_stats(ctx.get(), &fs_stats))
+      return fail(kExitFailure, "drape_context_get_frame_stats failed: " + libraryReason(r));
+    st.nonfinite += static_cast<uint64_t>(!std::isfinite(fs_stats.skeleton_ms)) +
+                    static_cast<uint64_t>(!std::isfinite(fs_stats.body_ms)) +
+                    static_cast<uint64_t>(!std::isfinite(fs_stats.body_volume_l));
+    st.skeleton_ms.push_back(fs_stats.skeleton_ms);
+    st.body_ms.push_back(fs_stats.body_ms);
+
+    if (drape_result r = drape_context_read_body_mesh(ctx.get(), positions.data(), normals.data(), vertex_count,
+                                                      indices.data(), index_count))
+      return fail(kExitFailure, "drape_context_read_body_mesh failed on frame " + std::to_string(i) + ": " +
+                                    libraryReason(r));
+    st.nonfinite += replay::countNonFinite(positions) + replay::countNonFinite(normals);
+    if (replay::isWatertight(indices, vertex_count)) ++st.watertight_frames;
+    const double volume_l = 1000.0 * replay::enclosedVolumeM3(positions, indices);
+    if (std::isfinite(volume_l)) st.volume_l.push_back(volume_l);
+
+    if (opt.write_obj) {
+      const fs::path obj = fs::path(opt.out_dir) / replay::objFileName(i);
+      const std::string comment = "drape-replay frame " + std::to_string(i) + ", t = " + std::to_string(timestamp) +
+                                  " s, " + std::to_string(vertex_count) + " vertices";
+      if (!replay::writeObj(obj.string(), positions, normals, indices, comment, error))
+        return fail(kExitFailure, error);
+    }
+  }
+
+  drape_frame_stats final_stats{};
+  final_stats.struct_size = sizeof final_stats;
+  if (drape_result r = drape_context_get_frame_stats(ctx.get(), &final_stats))
+    return fail(kExitFailure, "drape_context_get_frame_stats failed: " + libraryReason(r));
+  st.teleports = final_stats.teleports;
+
+  if (!stats_path.empty()) {
+    const std::string json = replay::statsJson(st);
+    std::FILE* f = std::fopen(stats_path.c_str(), "wb");
+    const bool ok = f && std::fwrite(json.data(), 1, json.size(), f) == json.size();
+    if (f && std::fclose(f) != 0) return fail(kExitFailure, "cannot write stats file '" + stats_path + "'");
+    if (!ok) return fail(kExitFailure, "cannot write stats file '" + stats_path + "'; check --stats/--out");
+  }
+  if (!opt.quiet)
+    std::fputs(replay::summaryText(st, opt.write_obj ? opt.out_dir : std::string(), stats_path).c_str(), stdout);
+  return kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {  // std::bad_alloc, filesystem errors
+    return fail(kExitFailure, std::string("unexpected failure: ") + e.what());
+  }
+}
