@@ -1,0 +1,158 @@
+// P/Invoke declarations for EVERY function of the C ABI in native/include/drape/drape.h, in the
+// header's order and with the header's names. Drape.Tests checks that the two lists agree
+// (NativeApiTests), so a function added to the header without a line here fails CI.
+//
+// Only blittable types cross: pointers, IntPtr/UIntPtr, int/uint/double, int-backed enums and the
+// blittable structs of Types.cs. Nothing is marshalled (no bool, no string, no array): strings
+// coming back are `const char*` (IntPtr, decoded by Utf8.FromNative), strings going in are
+// NUL-terminated UTF-8 byte buffers (Utf8.ToNative). Handles are opaque IntPtr.
+using System;
+using System.Runtime.InteropServices;
+
+namespace Drape
+{
+    internal static unsafe class Native
+    {
+        /// <summary>
+        /// The one place the native library's name is written. "drape" resolves to libdrape.so
+        /// (Linux, Android), libdrape.dylib (macOS) and drape.dll (Windows). On iOS (and WebGL)
+        /// the library is linked statically into the player, and P/Invoke must name "__Internal"
+        /// instead: Unity defines UNITY_IOS when it compiles these sources for an iOS player.
+        /// A prebuilt Drape.dll (compiled outside Unity) always says "drape".
+        /// </summary>
+        internal const string LibraryName =
+#if (UNITY_IOS || UNITY_WEBGL) && !UNITY_EDITOR
+            "__Internal";
+#else
+            "drape";
+#endif
+
+        /// <summary>The header version these declarations were written against (DRAPE_VERSION_*).
+        /// Only the major part must match the loaded library (see DrapeLibrary.EnsureCompatible).</summary>
+        internal const uint HeaderVersionMajor = 0;
+        internal const uint HeaderVersionMinor = 1;
+        internal const uint HeaderVersionPatch = 0;
+
+        private const CallingConvention Cdecl = CallingConvention.Cdecl;
+
+        // ---- Results and errors ----------------------------------------------------------------
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern IntPtr drape_result_name(ResultCode result);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern IntPtr drape_last_error();
+
+        // ---- Version ---------------------------------------------------------------------------
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern uint drape_version();
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern IntPtr drape_version_string();
+
+        // ---- Context ---------------------------------------------------------------------------
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_desc_init(ContextDesc* desc);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_create(ContextDesc* desc, IntPtr* outContext);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_destroy(IntPtr context);
+
+        // ---- Body shape ------------------------------------------------------------------------
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_body_shape_init(BodyShape* shape);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_set_body_shape(IntPtr context, BodyShape* shape);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_get_body_shape(IntPtr context, BodyShape* outShape);
+
+        // ---- Skeleton input --------------------------------------------------------------------
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_push_skeleton(IntPtr context, SkeletonFrame* frame);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_update(IntPtr context);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_read_skeleton(IntPtr context, Vector3f* positions,
+                                                                      uint capacity, uint* outCount);
+
+        // ---- Body mesh -------------------------------------------------------------------------
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_get_body_mesh_size(IntPtr context, uint* outVertexCount,
+                                                                           uint* outIndexCount);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_read_body_mesh(IntPtr context, Vector3f* positions,
+                                                                       Vector3f* normals, uint vertexCapacity,
+                                                                       uint* indices, uint indexCapacity);
+
+        // ---- Statistics ------------------------------------------------------------------------
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_get_frame_stats(IntPtr context, FrameStats* outStats);
+
+        // ---- Recordings ------------------------------------------------------------------------
+
+        /// <param name="pathUtf8">NUL-terminated UTF-8 path (see Utf8.ToNative).</param>
+        /// <param name="layout">drape_layout as int32_t.</param>
+        /// <param name="outRecording">receives the new handle.</param>
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_recording_open(byte* pathUtf8, int layout, IntPtr* outRecording);
+
+        /// <param name="data">the bytes (copied by the library).</param>
+        /// <param name="size">size_t byte count.</param>
+        /// <param name="layout">drape_layout as int32_t.</param>
+        /// <param name="outRecording">receives the new handle.</param>
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_recording_open_memory(void* data, UIntPtr size, int layout,
+                                                                      IntPtr* outRecording);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_recording_destroy(IntPtr recording);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_recording_get_info(IntPtr recording, RecordingInfo* outInfo);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_recording_read_frame(IntPtr recording, uint index, Joint* joints,
+                                                                     uint capacity, double* outTimestampS);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_recording_save(IntPtr recording, byte* pathUtf8);
+    }
+
+    /// <summary>UTF-8 conversions for the C ABI's <c>const char*</c>, without any marshaller.</summary>
+    internal static unsafe class Utf8
+    {
+        /// <summary>Decodes a NUL-terminated UTF-8 string owned by the library ("" for NULL).</summary>
+        internal static string FromNative(IntPtr text)
+        {
+            if (text == IntPtr.Zero) return string.Empty;
+            byte* p = (byte*)text;
+            int length = 0;
+            while (p[length] != 0) ++length;
+            return System.Text.Encoding.UTF8.GetString(p, length);
+        }
+
+        /// <summary>Encodes <paramref name="text"/> as NUL-terminated UTF-8 (the library's paths).</summary>
+        internal static byte[] ToNative(string text, string paramName)
+        {
+            if (text is null) throw new ArgumentNullException(paramName);
+            if (text.IndexOf('\0') >= 0) throw new ArgumentException("the string contains a NUL character", paramName);
+            int n = System.Text.Encoding.UTF8.GetByteCount(text);
+            var bytes = new byte[n + 1];
+            System.Text.Encoding.UTF8.GetBytes(text, 0, text.Length, bytes, 0);
+            return bytes;
+        }
+    }
+}
