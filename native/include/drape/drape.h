@@ -137,14 +137,14 @@ typedef struct drape_context_desc {
   uint32_t calibration_frames;   /* frames over which bone lengths are measured, then held:
                                     [1, 100000]; default 30 */
   int32_t filter;                /* drape_filter; default DRAPE_FILTER_ONE_EURO */
-  float filter_min_cutoff_hz;    /* One-Euro minimum cutoff (Hz), > 0 */
-  float filter_beta;             /* One-Euro speed coefficient, >= 0 */
-  float filter_d_cutoff_hz;      /* One-Euro derivative cutoff (Hz), > 0 */
-  float smoothing;               /* double exponential: [0, 1) */
-  float correction;              /* double exponential: [0, 1] */
-  float prediction;              /* double exponential: [0, 10] */
-  float jitter_radius_m;         /* double exponential: >= 0 */
-  float max_deviation_m;         /* double exponential: >= 0 */
+  float filter_min_cutoff_hz;    /* One-Euro minimum cutoff (Hz), [0.001, 1000]; 1 */
+  float filter_beta;             /* One-Euro speed coefficient, [0, 1000]; 1 */
+  float filter_d_cutoff_hz;      /* One-Euro derivative cutoff (Hz), [0.001, 1000]; 1 */
+  float smoothing;               /* double exponential: [0, 0.999]; 0.5 */
+  float correction;              /* double exponential: [0, 1]; 0.5 */
+  float prediction;              /* double exponential, in 30 Hz frames: [0, 10]; 0.5 */
+  float jitter_radius_m;         /* double exponential: [0, 10]; 0.05 */
+  float max_deviation_m;         /* double exponential: [0, 10]; 0.04 */
   float teleport_distance_m;     /* a pelvis jump beyond this (plus what 5 m/s covers in the
                                     frame's dt) is reported as a teleport; (0, 100]; 0.5 */
 } drape_context_desc;
@@ -194,7 +194,8 @@ DRAPE_API drape_result DRAPE_CALL drape_body_shape_init(drape_body_shape* shape)
 DRAPE_API drape_result DRAPE_CALL drape_context_set_body_shape(drape_context* context,
                                                                const drape_body_shape* shape);
 
-/* Reads the shape in use with every girth resolved (predicted ones filled in).
+/* Reads the shape in use with every girth resolved: girths the host gave come back exactly as
+ * given, predicted ones are filled in.
  * `out_shape->struct_size` must be set by the caller (drape_body_shape_init does). */
 DRAPE_API drape_result DRAPE_CALL drape_context_get_body_shape(drape_context* context,
                                                                drape_body_shape* out_shape);
@@ -214,16 +215,17 @@ typedef struct drape_skeleton_frame {
                                       and stored for the host, the body follows positions */
 } drape_skeleton_frame;
 
-/* Validates one frame and queues it for the next drape_context_update. A rejected frame (bad
- * layout, count, NaN/Inf or |coordinate| > 1000 m, timestamp not after the previous accepted
- * frame) returns an error, is counted in drape_frame_stats.frames_rejected and leaves every bit of
+/* Validates one frame and queues it for the next drape_context_update. A rejected frame (NULL,
+ * bad struct_size, layout or count, NaN/Inf or |coordinate| > 1000 m, tracking state outside
+ * 0..2, non-unit orientation, timestamp not after the previous accepted frame) returns an error,
+ * is counted in drape_frame_stats.frames_rejected and leaves every bit of
  * the context's state as it was. Pushing twice without an update replaces the queued frame (the
  * newest wins; the replaced one counts as dropped). Thread-safety: one thread per context. */
 DRAPE_API drape_result DRAPE_CALL drape_context_push_skeleton(drape_context* context,
                                                               const drape_skeleton_frame* frame);
 
 /* Runs the pipeline on the queued frame: skeleton filter -> feature rings -> body mesh.
- * DRAPE_ERROR_CALL_ORDER if no frame was ever pushed. Calling it again without a new frame is
+ * DRAPE_ERROR_CALL_ORDER if no frame was ever accepted. Calling it again without a new frame is
  * allowed and cheap (nothing changes). Thread-safety: one thread per context. */
 DRAPE_API drape_result DRAPE_CALL drape_context_update(drape_context* context);
 
@@ -239,7 +241,7 @@ DRAPE_API drape_result DRAPE_CALL drape_context_read_skeleton(drape_context* con
 /* ------------------------------------------------------------------------------------------ */
 
 /* Size query: vertex and index counts of the body mesh (fixed for a context: they depend only on
- * ring_points and rings_per_segment). Either out pointer may be NULL. */
+ * ring_points and rings_per_segment). One of the two out pointers may be NULL, not both. */
 DRAPE_API drape_result DRAPE_CALL drape_context_get_body_mesh_size(drape_context* context,
                                                                    uint32_t* out_vertex_count,
                                                                    uint32_t* out_index_count);
@@ -306,7 +308,8 @@ typedef struct drape_recording_info {
   double duration_s;
 } drape_recording_info;
 
-/* Reads a whole recording file. layout: DRAPE_LAYOUT_AUTO, or the layout the file must have (an
+/* Reads a whole recording file. `path` is UTF-8 (on Windows, paths outside the ANSI code page are
+ * not supported yet). layout: DRAPE_LAYOUT_AUTO, or the layout the file must have (an
  * error if it contradicts the content). On success the caller owns *out_recording and releases it
  * with drape_recording_destroy. Any thread. */
 DRAPE_API drape_result DRAPE_CALL drape_recording_open(const char* path, int32_t layout,

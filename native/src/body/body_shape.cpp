@@ -5,7 +5,8 @@
 
 namespace drape {
 
-bool validateShapeInput(const BodyShapeInput& in, std::string& err) {
+bool validateShapeInput(const BodyShapeInput& in, std::string& err, bool* nonfinite) {
+  if (nonfinite) *nonfinite = false;
   auto bad = [&](const char* what, float v, const char* range) {
     std::ostringstream s;
     s << "body shape: " << what << " = " << v << " is outside " << range;
@@ -13,7 +14,9 @@ bool validateShapeInput(const BodyShapeInput& in, std::string& err) {
     return false;
   };
   if (!std::isfinite(in.height_m) || !std::isfinite(in.weight_kg)) {
-    err = "body shape: height and weight must be finite numbers";
+    if (nonfinite) *nonfinite = true;
+    err = std::string("body shape: ") + (std::isfinite(in.height_m) ? "weight_kg" : "height_m") +
+          " is not a finite number";
     return false;
   }
   if (in.height_m < 0.8f || in.height_m > 2.5f) return bad("height_m", in.height_m, "[0.8, 2.5]");
@@ -21,6 +24,7 @@ bool validateShapeInput(const BodyShapeInput& in, std::string& err) {
   for (int i = 0; i < kGirthCount; ++i) {
     const float g = in.girth_mm[i];
     if (!std::isfinite(g)) {
+      if (nonfinite) *nonfinite = true;
       err = std::string("body shape: ") + measureName(static_cast<Measure>(i)) + "_mm is not finite";
       return false;
     }

@@ -31,7 +31,8 @@ struct ResolvedShape {
 };
 
 // Validates ranges (height 0.8..2.5 m, weight 15..300 kg, girths 0 or 50..3000 mm, finite).
-bool validateShapeInput(const BodyShapeInput& in, std::string& err);
+// `nonfinite` (optional) tells a NaN/Inf apart from an out-of-range value.
+bool validateShapeInput(const BodyShapeInput& in, std::string& err, bool* nonfinite = nullptr);
 
 // Fills every measurement: given girths as given, the rest predicted. Predicted breadths/depths
 // are rescaled so the depth:breadth ratio follows the girth actually used.

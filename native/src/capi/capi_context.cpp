@@ -128,7 +128,9 @@ DRAPE_API drape_result DRAPE_CALL drape_context_get_body_shape(drape_context* co
     o.weight_kg = s.input.weight_kg;
     float* g[drape::kGirthCount] = {&o.neck_mm, &o.chest_mm, &o.waist_mm, &o.hip_mm,
                                     &o.thigh_mm, &o.calf_mm, &o.upper_arm_mm, &o.forearm_mm};
-    for (int i = 0; i < drape::kGirthCount; ++i) *g[i] = 1000.0f * s.m[i];
+    // Girths the host gave come back bit-exact; predicted ones in mm.
+    for (int i = 0; i < drape::kGirthCount; ++i)
+      *g[i] = s.girth_given[i] ? s.input.girth_mm[i] : 1000.0f * s.m[i];
     *out_shape = o;
     return DRAPE_OK;
   });
@@ -138,9 +140,14 @@ DRAPE_API drape_result DRAPE_CALL drape_context_push_skeleton(drape_context* con
                                                               const drape_skeleton_frame* frame) {
   return guarded("drape_context_push_skeleton", [&]() -> drape_result {
     DRAPE_CHECK_CONTEXT("drape_context_push_skeleton", context);
-    if (!frame) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_push_skeleton: frame is NULL");
-    if (drape_result r = checkStructSize(frame->struct_size, sizeof(drape_skeleton_frame), "drape_skeleton_frame"))
+    if (!frame) {
+      asContext(context)->countRejectedFrame();
+      return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_push_skeleton: frame is NULL");
+    }
+    if (drape_result r = checkStructSize(frame->struct_size, sizeof(drape_skeleton_frame), "drape_skeleton_frame")) {
+      asContext(context)->countRejectedFrame();
       return r;
+    }
     std::string err;
     if (drape_result r = asContext(context)->pushFrame(*frame, err))
       return fail(r, "drape_context_push_skeleton: " + err);
@@ -250,7 +257,7 @@ static_assert(sizeof(drape_quat) == 16, "drape_quat layout");
 static_assert(sizeof(drape_joint) == 16, "drape_joint layout");
 static_assert(sizeof(drape_context_desc) == 56, "drape_context_desc layout");
 static_assert(sizeof(drape_body_shape) == 48, "drape_body_shape layout");
-static_assert(sizeof(drape_skeleton_frame) == 40, "drape_skeleton_frame layout");
+static_assert(sizeof(drape_skeleton_frame) == 24 + 2 * sizeof(void*), "drape_skeleton_frame layout");
 static_assert(sizeof(drape_frame_stats) == 64, "drape_frame_stats layout");
 static_assert(sizeof(drape_recording_info) == 32, "drape_recording_info layout");
 static_assert(sizeof(drape_result) == 4, "enums are 32-bit");

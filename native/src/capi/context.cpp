@@ -84,10 +84,9 @@ Context::Context(const drape_context_desc& desc)
 }
 
 drape_result Context::setShape(const BodyShapeInput& in, std::string& err) {
-  if (!validateShapeInput(in, err)) {
-    const bool nonfinite = err.find("finite") != std::string::npos;
+  bool nonfinite = false;
+  if (!validateShapeInput(in, err, &nonfinite))
     return nonfinite ? DRAPE_ERROR_NONFINITE : DRAPE_ERROR_OUT_OF_RANGE;
-  }
   shape_ = resolveShape(in);
   body_->setShape(shape_);
   shapeDirty_ = true;
@@ -169,7 +168,7 @@ drape_result Context::pushFrame(const drape_skeleton_frame& f, std::string& err)
 
 drape_result Context::update(std::string& err) {
   if (!hasQueued_ && !updated_) {
-    err = "update: no skeleton frame has been pushed yet (call drape_context_push_skeleton first)";
+    err = "update: no skeleton frame has been accepted yet (call drape_context_push_skeleton first)";
     return DRAPE_ERROR_CALL_ORDER;
   }
   if (hasQueued_) {

@@ -25,6 +25,8 @@ class Context {
   drape_result setShape(const BodyShapeInput& in, std::string& err);
   drape_result pushFrame(const drape_skeleton_frame& frame, std::string& err);
   drape_result update(std::string& err);
+  // A frame rejected before it reached pushFrame (NULL, bad struct_size) still counts.
+  void countRejectedFrame() { ++pushed_; ++rejected_; }
 
   const ResolvedShape& shape() const { return shape_; }
   const BodyModel& body() const { return *body_; }
