@@ -130,6 +130,12 @@ typedef enum drape_filter {
   DRAPE_FILTER_FORCE32 = 0x7fffffff
 } drape_filter;
 
+typedef enum drape_proxy_rule {
+  DRAPE_PROXY_RULE_PAPER = 0, /* the paper's eq. 5-6: per torso ring, one per limb bone */
+  DRAPE_PROXY_RULE_DRAPE = 1, /* per ring everywhere, sized to close the gaps (docs/proxies.md) */
+  DRAPE_PROXY_RULE_FORCE32 = 0x7fffffff
+} drape_proxy_rule;
+
 typedef struct drape_context_desc {
   uint32_t struct_size;          /* sizeof(drape_context_desc), set by drape_context_desc_init */
   uint32_t ring_points;          /* K, points per feature ring: multiple of 4 in [8, 256]; 20 */
@@ -147,6 +153,9 @@ typedef struct drape_context_desc {
   float max_deviation_m;         /* double exponential: [0, 10]; 0.04 */
   float teleport_distance_m;     /* a pelvis jump beyond this (plus what 5 m/s covers in the
                                     frame's dt) is reported as a teleport; (0, 100]; 0.5 */
+  int32_t proxy_rule;            /* drape_proxy_rule: how tracking ellipsoids are built;
+                                    default DRAPE_PROXY_RULE_DRAPE */
+  uint32_t reserved;             /* 0 */
 } drape_context_desc;
 
 /* Fills `desc` with defaults and struct_size. */
@@ -260,6 +269,57 @@ DRAPE_API drape_result DRAPE_CALL drape_context_read_body_mesh(drape_context* co
                                                                uint32_t index_capacity);
 
 /* ------------------------------------------------------------------------------------------ */
+/* Tracking ellipsoids (proxies)                                                               */
+/* ------------------------------------------------------------------------------------------ */
+
+/* One tracking ellipsoid: world point p is inside when |diag(1/radii) * [axis_x axis_y axis_z]^T
+ * (p - centre)| < 1. Axes are unit and orthogonal (a rotation); axis_y runs along the bone. */
+typedef struct drape_ellipsoid {
+  drape_vec3 centre;
+  drape_vec3 axis_x;  /* body forward (limbs: carried along the limb without twist) */
+  drape_vec3 axis_y;  /* along the bone */
+  drape_vec3 axis_z;  /* axis_x x axis_y */
+  drape_vec3 radii;   /* semi-axes along axis_x, axis_y, axis_z, metres */
+  int32_t chain;      /* 0 torso, 1 neck and head, 2 left arm, 3 right arm, 4 left leg, 5 right leg */
+  int32_t ring;       /* index of the feature ring it was built from */
+} drape_ellipsoid;
+
+/* Number of tracking ellipsoids (fixed for a context: depends on the rule and the ring layout). */
+DRAPE_API drape_result DRAPE_CALL drape_context_get_ellipsoid_count(drape_context* context,
+                                                                    uint32_t* out_count);
+
+/* Copies the ellipsoids of the last update (capacity >= count). out_count may be NULL.
+ * DRAPE_ERROR_CALL_ORDER before the first update. */
+DRAPE_API drape_result DRAPE_CALL drape_context_read_ellipsoids(drape_context* context,
+                                                                drape_ellipsoid* ellipsoids,
+                                                                uint32_t capacity,
+                                                                uint32_t* out_count);
+
+/* Same as 4x4 column-major matrices M = T * R * S (unit sphere -> ellipsoid), 16 floats each, for
+ * debug drawing a unit sphere mesh. capacity counts matrices. */
+DRAPE_API drape_result DRAPE_CALL drape_context_read_ellipsoid_matrices(drape_context* context,
+                                                                        float* matrices,
+                                                                        uint32_t capacity,
+                                                                        uint32_t* out_count);
+
+/* How closely the ellipsoids follow the body mesh of the last update (docs/proxies.md):
+ * body -> proxies is each body vertex's distance outside the union of ellipsoids (0 inside);
+ * proxies -> body is the distance from points on the union's surface to the body surface. */
+typedef struct drape_proxy_fidelity {
+  uint32_t struct_size;          /* caller sets sizeof(drape_proxy_fidelity) */
+  uint32_t union_samples;        /* surface points of the union measured */
+  float body_to_proxy_mean_mm, body_to_proxy_p95_mm, body_to_proxy_max_mm;
+  float proxy_to_body_mean_mm, proxy_to_body_p95_mm, proxy_to_body_max_mm;
+  float outside_fraction;        /* body vertices outside every ellipsoid by more than 0.5 mm */
+  float reserved;
+} drape_proxy_fidelity;
+
+/* Measures the fidelity now (about a millisecond: it is a diagnostic, not a per-frame stage).
+ * DRAPE_ERROR_CALL_ORDER before the first update. */
+DRAPE_API drape_result DRAPE_CALL drape_context_measure_proxy_fidelity(drape_context* context,
+                                                                       drape_proxy_fidelity* out);
+
+/* ------------------------------------------------------------------------------------------ */
 /* Statistics                                                                                  */
 /* ------------------------------------------------------------------------------------------ */
 
@@ -277,6 +337,7 @@ typedef struct drape_frame_stats {
   double last_timestamp_s;    /* of the last accepted frame */
   double skeleton_ms;         /* wall time of the last update's skeleton stage */
   double body_ms;             /* wall time of the last update's ring + mesh stage */
+  double proxies_ms;          /* wall time of the last update's tracking-ellipsoid stage */
   float body_volume_l;        /* enclosed volume of the body mesh after the last update */
   float reserved2;
 } drape_frame_stats;

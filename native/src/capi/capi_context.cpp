@@ -53,6 +53,7 @@ DRAPE_API drape_result DRAPE_CALL drape_context_desc_init(drape_context_desc* de
   desc->jitter_radius_m = t.jitter_radius_m;
   desc->max_deviation_m = t.max_deviation_m;
   desc->teleport_distance_m = t.teleport_distance_m;
+  desc->proxy_rule = DRAPE_PROXY_RULE_DRAPE;
   return DRAPE_OK;
 }
 
@@ -249,15 +250,113 @@ DRAPE_API drape_result DRAPE_CALL drape_context_get_frame_stats(drape_context* c
   });
 }
 
+DRAPE_API drape_result DRAPE_CALL drape_context_get_ellipsoid_count(drape_context* context, uint32_t* out_count) {
+  return guarded("drape_context_get_ellipsoid_count", [&]() -> drape_result {
+    DRAPE_CHECK_CONTEXT("drape_context_get_ellipsoid_count", context);
+    if (!out_count) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_get_ellipsoid_count: out_count is NULL");
+    *out_count = static_cast<uint32_t>(asContext(context)->proxies().ellipsoids().size());
+    return DRAPE_OK;
+  });
+}
+
+namespace {
+// Shared checks of the two ellipsoid readers; returns the ellipsoids to copy or sets `r`.
+const std::vector<drape::Ellipsoid>* ellipsoidsToRead(const char* fn, drape_context* context, const void* out,
+                                                      uint32_t capacity, drape_result& r) {
+  Context* ctx = asContext(context);
+  const auto& e = ctx->proxies().ellipsoids();
+  if (!out) {
+    r = fail(DRAPE_ERROR_NULL_ARGUMENT, std::string(fn) + ": output buffer is NULL");
+  } else if (capacity < e.size()) {
+    r = fail(DRAPE_ERROR_BUFFER_TOO_SMALL, std::string(fn) + ": capacity " + std::to_string(capacity) + " < " +
+                                               std::to_string(e.size()) + " ellipsoids");
+  } else if (!ctx->hasUpdate()) {
+    r = fail(DRAPE_ERROR_CALL_ORDER, std::string(fn) + ": no update has run yet");
+  } else {
+    r = DRAPE_OK;
+    return &e;
+  }
+  return nullptr;
+}
+drape_vec3 v3(const drape::Vec3& v) { return drape_vec3{v.x(), v.y(), v.z()}; }
+}  // namespace
+
+DRAPE_API drape_result DRAPE_CALL drape_context_read_ellipsoids(drape_context* context, drape_ellipsoid* ellipsoids,
+                                                                uint32_t capacity, uint32_t* out_count) {
+  return guarded("drape_context_read_ellipsoids", [&]() -> drape_result {
+    DRAPE_CHECK_CONTEXT("drape_context_read_ellipsoids", context);
+    drape_result r = DRAPE_OK;
+    const auto* e = ellipsoidsToRead("drape_context_read_ellipsoids", context, ellipsoids, capacity, r);
+    if (!e) return r;
+    const auto& sources = asContext(context)->proxies().sources();
+    for (size_t i = 0; i < e->size(); ++i) {
+      const drape::Ellipsoid& el = (*e)[i];
+      ellipsoids[i] = drape_ellipsoid{v3(el.centre), v3(el.rotation.col(0)), v3(el.rotation.col(1)),
+                                      v3(el.rotation.col(2)), v3(el.radii),
+                                      static_cast<int32_t>(sources[i].chain), sources[i].first_ring};
+    }
+    if (out_count) *out_count = static_cast<uint32_t>(e->size());
+    return DRAPE_OK;
+  });
+}
+
+DRAPE_API drape_result DRAPE_CALL drape_context_read_ellipsoid_matrices(drape_context* context, float* matrices,
+                                                                        uint32_t capacity, uint32_t* out_count) {
+  return guarded("drape_context_read_ellipsoid_matrices", [&]() -> drape_result {
+    DRAPE_CHECK_CONTEXT("drape_context_read_ellipsoid_matrices", context);
+    drape_result r = DRAPE_OK;
+    const auto* e = ellipsoidsToRead("drape_context_read_ellipsoid_matrices", context, matrices, capacity, r);
+    if (!e) return r;
+    for (size_t i = 0; i < e->size(); ++i) {
+      const drape::Ellipsoid& el = (*e)[i];
+      Eigen::Matrix4f m = Eigen::Matrix4f::Identity();
+      m.topLeftCorner<3, 3>() = el.rotation * el.radii.asDiagonal();
+      m.topRightCorner<3, 1>() = el.centre;
+      std::memcpy(matrices + 16 * i, m.data(), 16 * sizeof(float));  // Eigen is column-major
+    }
+    if (out_count) *out_count = static_cast<uint32_t>(e->size());
+    return DRAPE_OK;
+  });
+}
+
+DRAPE_API drape_result DRAPE_CALL drape_context_measure_proxy_fidelity(drape_context* context,
+                                                                       drape_proxy_fidelity* out) {
+  return guarded("drape_context_measure_proxy_fidelity", [&]() -> drape_result {
+    DRAPE_CHECK_CONTEXT("drape_context_measure_proxy_fidelity", context);
+    if (!out) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_measure_proxy_fidelity: out is NULL");
+    if (drape_result r = checkStructSize(out->struct_size, sizeof(drape_proxy_fidelity), "drape_proxy_fidelity"))
+      return r;
+    Context* ctx = asContext(context);
+    if (!ctx->hasUpdate())
+      return fail(DRAPE_ERROR_CALL_ORDER, "drape_context_measure_proxy_fidelity: no update has run yet");
+    const drape::FidelityReport f = ctx->measureFidelity();
+    drape_proxy_fidelity o;
+    std::memset(&o, 0, sizeof(o));
+    o.struct_size = sizeof(o);
+    o.union_samples = static_cast<uint32_t>(f.union_samples);
+    o.body_to_proxy_mean_mm = f.body_to_union_mean_mm;
+    o.body_to_proxy_p95_mm = f.body_to_union_p95_mm;
+    o.body_to_proxy_max_mm = f.body_to_union_max_mm;
+    o.proxy_to_body_mean_mm = f.union_to_body_mean_mm;
+    o.proxy_to_body_p95_mm = f.union_to_body_p95_mm;
+    o.proxy_to_body_max_mm = f.union_to_body_max_mm;
+    o.outside_fraction = f.outside_fraction;
+    *out = o;
+    return DRAPE_OK;
+  });
+}
+
 }  // extern "C"
 
 // Layout guarantees the C# bindings (and any other FFI) rely on.
 static_assert(sizeof(drape_vec3) == 12, "drape_vec3 layout");
 static_assert(sizeof(drape_quat) == 16, "drape_quat layout");
 static_assert(sizeof(drape_joint) == 16, "drape_joint layout");
-static_assert(sizeof(drape_context_desc) == 56, "drape_context_desc layout");
+static_assert(sizeof(drape_context_desc) == 64, "drape_context_desc layout");
+static_assert(sizeof(drape_ellipsoid) == 68, "drape_ellipsoid layout");
+static_assert(sizeof(drape_proxy_fidelity) == 40, "drape_proxy_fidelity layout");
 static_assert(sizeof(drape_body_shape) == 48, "drape_body_shape layout");
 static_assert(sizeof(drape_skeleton_frame) == 24 + 2 * sizeof(void*), "drape_skeleton_frame layout");
-static_assert(sizeof(drape_frame_stats) == 64, "drape_frame_stats layout");
+static_assert(sizeof(drape_frame_stats) == 72, "drape_frame_stats layout");
 static_assert(sizeof(drape_recording_info) == 32, "drape_recording_info layout");
 static_assert(sizeof(drape_result) == 4, "enums are 32-bit");

@@ -3,7 +3,6 @@
 #include "recording/recording.h"
 
 #include <cstring>
-#include <fstream>
 #include <memory>
 
 using namespace drape::api;
@@ -26,6 +25,16 @@ drape_result checkLayoutHint(const char* fn, int32_t layout) {
   return DRAPE_OK;
 }
 
+drape_result codeFor(drape::RecordingError kind) {
+  switch (kind) {
+    case drape::RecordingError::Io: return DRAPE_ERROR_IO;
+    case drape::RecordingError::OutOfMemory: return DRAPE_ERROR_OUT_OF_MEMORY;
+    case drape::RecordingError::InvalidArgument: return DRAPE_ERROR_INVALID_ARGUMENT;
+    case drape::RecordingError::Internal: return DRAPE_ERROR_INTERNAL;
+    default: return DRAPE_ERROR_PARSE;
+  }
+}
+
 drape_result adopt(std::unique_ptr<drape::Recording> rec, drape_recording** out) {
   registerHandle(HandleKind::Recording, rec.get());
   *out = reinterpret_cast<drape_recording*>(rec.release());
@@ -42,14 +51,11 @@ DRAPE_API drape_result DRAPE_CALL drape_recording_open(const char* path, int32_t
     if (!path) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_recording_open: path is NULL");
     if (!out_recording) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_recording_open: out_recording is NULL");
     if (drape_result r = checkLayoutHint("drape_recording_open", layout)) return r;
-    {
-      std::ifstream probe(path, std::ios::binary);
-      if (!probe) return fail(DRAPE_ERROR_IO, std::string("drape_recording_open: cannot open '") + path + "'");
-    }
     auto rec = std::make_unique<drape::Recording>();
     std::string err;
-    if (!drape::readRecordingFile(path, layout, *rec, err))
-      return fail(DRAPE_ERROR_PARSE, "drape_recording_open: " + err);
+    drape::RecordingError kind = drape::RecordingError::None;
+    if (!drape::readRecordingFile(path, layout, *rec, err, &kind))
+      return fail(codeFor(kind), "drape_recording_open: " + err);
     return adopt(std::move(rec), out_recording);
   });
 }
@@ -63,8 +69,9 @@ DRAPE_API drape_result DRAPE_CALL drape_recording_open_memory(const void* data, 
     auto rec = std::make_unique<drape::Recording>();
     std::string err;
     const std::string_view text(static_cast<const char*>(data), data ? size : 0);
-    if (!drape::parseRecording(text, layout, *rec, err))
-      return fail(DRAPE_ERROR_PARSE, "drape_recording_open_memory: " + err);
+    drape::RecordingError kind = drape::RecordingError::None;
+    if (!drape::parseRecording(text, layout, *rec, err, &kind))
+      return fail(codeFor(kind), "drape_recording_open_memory: " + err);
     return adopt(std::move(rec), out_recording);
   });
 }
@@ -130,8 +137,9 @@ DRAPE_API drape_result DRAPE_CALL drape_recording_save(drape_recording* recordin
     DRAPE_CHECK_RECORDING("drape_recording_save", recording);
     if (!path) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_recording_save: path is NULL");
     std::string err;
-    if (!drape::writeDrapeRecordingFile(*asRecording(recording), path, err))
-      return fail(DRAPE_ERROR_IO, "drape_recording_save: " + err);
+    drape::RecordingError kind = drape::RecordingError::None;
+    if (!drape::writeDrapeRecordingFile(*asRecording(recording), path, err, &kind))
+      return fail(kind == drape::RecordingError::Io ? DRAPE_ERROR_IO : codeFor(kind), "drape_recording_save: " + err);
     return DRAPE_OK;
   });
 }

@@ -53,6 +53,9 @@ drape_result validateContextDesc(const drape_context_desc& d, std::string& err) 
   } else if ((r = range("jitter_radius_m", d.jitter_radius_m, 0, 10)) != DRAPE_OK) {
   } else if ((r = range("max_deviation_m", d.max_deviation_m, 0, 10)) != DRAPE_OK) {
   } else if ((r = range("teleport_distance_m", d.teleport_distance_m, 1e-6, 100)) != DRAPE_OK) {
+  } else if (d.proxy_rule != DRAPE_PROXY_RULE_PAPER && d.proxy_rule != DRAPE_PROXY_RULE_DRAPE) {
+    s << "context desc: proxy_rule = " << d.proxy_rule << " is not 0 (paper) or 1 (drape)";
+    r = DRAPE_ERROR_OUT_OF_RANGE;
   }
   err = s.str();
   return r;
@@ -75,11 +78,16 @@ TrackerParams trackerParamsFrom(const drape_context_desc& d) {
 }
 
 Context::Context(const drape_context_desc& desc)
-    : desc_(desc), shape_(resolveShape(BodyShapeInput{})), tracker_(trackerParamsFrom(desc)) {
+    : desc_(desc),
+      shape_(resolveShape(BodyShapeInput{})),
+      tracker_(trackerParamsFrom(desc)),
+      proxies_(static_cast<ProxyRule>(desc.proxy_rule)) {
   BodyModelParams bp;
   bp.ring_points = static_cast<int>(desc.ring_points);
   bp.rings_per_segment = static_cast<int>(desc.rings_per_segment);
   body_ = std::make_unique<BodyModel>(shape_, bp);
+  // Size the ellipsoid arrays once (on the rest pose) so updates never allocate.
+  proxies_.build(*body_, restPose(shape_));
   orientations_.reserve(32);
 }
 
@@ -194,6 +202,9 @@ drape_result Context::update(std::string& err) {
   const auto t1 = Clock::now();
   body_->update(pose);
   bodyMs_ = msSince(t1);
+  const auto t2 = Clock::now();
+  proxies_.build(*body_, pose);
+  proxiesMs_ = msSince(t2);
   updated_ = true;
   shapeDirty_ = false;
   volumeDirty_ = true;
@@ -217,8 +228,25 @@ void Context::fillStats(drape_frame_stats& out) {
   out.last_timestamp_s = lastAcceptedTime_;
   out.skeleton_ms = skeletonMs_;
   out.body_ms = bodyMs_;
+  out.proxies_ms = proxiesMs_;
   out.body_volume_l = updated_ ? volumeL_ : 0.0f;
   out.reserved2 = 0.0f;
+}
+
+}  // namespace drape
+
+namespace drape {
+
+FidelityReport Context::measureFidelity() {
+  // The topology never changes, so after the first build a refit follows the moved vertices.
+  if (!bvhBuilt_) {
+    bvh_.build(body_->positions(), body_->indices());
+    bvhBuilt_ = true;
+  } else {
+    bvh_.refit(body_->positions());
+  }
+  const auto& e = proxies_.ellipsoids();
+  return drape::measureFidelity(body_->positions(), body_->indices(), e.data(), static_cast<int>(e.size()), bvh_);
 }
 
 }  // namespace drape

@@ -4,6 +4,9 @@
 
 #include "body/body_model.h"
 #include "body/body_shape.h"
+#include "proxies/fidelity.h"
+#include "proxies/mesh_bvh.h"
+#include "proxies/proxy_builder.h"
 #include "drape/drape.h"
 #include "skeleton/tracker.h"
 
@@ -31,6 +34,9 @@ class Context {
   const ResolvedShape& shape() const { return shape_; }
   const BodyModel& body() const { return *body_; }
   const SkeletonTracker& tracker() const { return tracker_; }
+  const ProxyBuilder& proxies() const { return proxies_; }
+  // Fidelity of the current ellipsoids against the current body mesh (a diagnostic: ~ms).
+  FidelityReport measureFidelity();
   bool hasUpdate() const { return updated_; }
   void fillStats(drape_frame_stats& out);
 
@@ -39,6 +45,9 @@ class Context {
   ResolvedShape shape_;
   SkeletonTracker tracker_;
   std::unique_ptr<BodyModel> body_;
+  ProxyBuilder proxies_;
+  TriangleBvh bvh_;  // over the body mesh, built lazily for fidelity measurements
+  bool bvhBuilt_ = false;
 
   SkeletonPose queued_{};
   double queuedTime_ = 0.0;
@@ -51,7 +60,7 @@ class Context {
 
   uint32_t pushed_ = 0, accepted_ = 0, rejected_ = 0, dropped_ = 0, updates_ = 0;
   bool teleported_ = false;
-  double skeletonMs_ = 0.0, bodyMs_ = 0.0;
+  double skeletonMs_ = 0.0, bodyMs_ = 0.0, proxiesMs_ = 0.0;
   float volumeL_ = 0.0f;
   bool volumeDirty_ = true;
 };
