@@ -143,8 +143,8 @@ typedef struct drape_context_desc {
   uint32_t calibration_frames;   /* frames over which bone lengths are measured, then held:
                                     [1, 100000]; default 30 */
   int32_t filter;                /* drape_filter; default DRAPE_FILTER_ONE_EURO */
-  float filter_min_cutoff_hz;    /* One-Euro minimum cutoff (Hz), [0.001, 1000]; 1 */
-  float filter_beta;             /* One-Euro speed coefficient, [0, 1000]; 1 */
+  float filter_min_cutoff_hz;    /* One-Euro minimum cutoff (Hz), [0.001, 1000]; 0.5 */
+  float filter_beta;             /* One-Euro speed coefficient, [0, 1000]; 6 */
   float filter_d_cutoff_hz;      /* One-Euro derivative cutoff (Hz), [0.001, 1000]; 1 */
   float smoothing;               /* double exponential: [0, 0.999]; 0.5 */
   float correction;              /* double exponential: [0, 1]; 0.5 */
