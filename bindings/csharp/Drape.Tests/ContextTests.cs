@@ -58,11 +58,12 @@ namespace Drape.Tests
         public void ContextDesc_Defaults_AndACustomRingCountChangesTheMesh()
         {
             ContextDesc d = ContextDesc.CreateDefault();
-            Assert.Equal(56u, d.StructSize);
+            Assert.Equal(64u, d.StructSize);
             Assert.Equal(20u, d.RingPoints);
             Assert.Equal(1u, d.RingsPerSegment);
             Assert.Equal(30u, d.CalibrationFrames);
             Assert.Equal(Filter.OneEuro, d.Filter);
+            Assert.Equal(ProxyRule.Drape, d.ProxyRule);
             using var standard = new Context(d);
             d.RingPoints = 32;
             using var finer = new Context(d);
@@ -199,7 +200,7 @@ namespace Drape.Tests
             Run(ctx, 40);
             ReadAndCheckMesh(ctx);
             FrameStats s = ctx.GetFrameStats();
-            Assert.Equal(64u, s.StructSize);
+            Assert.Equal(72u, s.StructSize);
             Assert.Equal(40u, s.FramesPushed);
             Assert.Equal(40u, s.FramesAccepted);
             Assert.Equal(0u, s.FramesRejected);
@@ -211,6 +212,40 @@ namespace Drape.Tests
             var skeleton = new Vector3f[21];
             Assert.Equal(21, ctx.ReadSkeleton(skeleton));
             Assert.All(skeleton, p => Assert.True(p.IsFinite));
+        }
+
+        [Fact]
+        public void Ellipsoids_AfterUpdates_AreFiniteAndMatchTheirMatrices()
+        {
+            using var ctx = new Context();
+            int n = ctx.GetEllipsoidCount();
+            Assert.True(n > 20, $"{n} ellipsoids");
+            var early = new Ellipsoid[n];
+            var e = Assert.Throws<DrapeException>(() => ctx.ReadEllipsoids(early));
+            Assert.Equal(ResultCode.CallOrder, e.Code);
+
+            Run(ctx, 40);
+            var ellipsoids = new Ellipsoid[n];
+            Assert.Equal(n, ctx.ReadEllipsoids(ellipsoids));
+            var matrices = new float[16 * n];
+            Assert.Equal(n, ctx.ReadEllipsoidMatrices(matrices));
+            for (int i = 0; i < n; ++i)
+            {
+                Ellipsoid el = ellipsoids[i];
+                Assert.True(el.Radii.X > 0 && el.Radii.Y > 0 && el.Radii.Z > 0, $"ellipsoid {i} radii {el.Radii}");
+                Assert.True(el.Centre.IsFinite);
+                // Column 1 of M = AxisY * Radii.Y; column 3 = centre.
+                Assert.Equal(el.AxisY.X * el.Radii.Y, matrices[16 * i + 4], 4);
+                Assert.Equal(el.Centre.Z, matrices[16 * i + 14], 4);
+            }
+            var small = new Ellipsoid[n - 1];
+            Assert.Equal(ResultCode.BufferTooSmall, Assert.Throws<DrapeException>(() => ctx.ReadEllipsoids(small)).Code);
+
+            ProxyFidelity f = ctx.MeasureProxyFidelity();
+            Assert.Equal(40u, f.StructSize);
+            Assert.True(f.UnionSamples > 0);
+            Assert.True(f.BodyToProxyP95Mm >= 0 && f.BodyToProxyP95Mm < 30, $"body->proxy P95 {f.BodyToProxyP95Mm} mm");
+            Assert.True(f.ProxyToBodyP95Mm >= 0 && f.ProxyToBodyP95Mm < 30, $"proxy->body P95 {f.ProxyToBodyP95Mm} mm");
         }
 
         [Fact]

@@ -137,10 +137,11 @@ namespace Drape.Tests
         [Fact] public void Joint_Is16() => AssertLayout<Joint>(16, ("Position", 0), ("TrackingState", 12));
 
         [Fact]
-        public void ContextDesc_Is56() => AssertLayout<ContextDesc>(56,
+        public void ContextDesc_Is64() => AssertLayout<ContextDesc>(64,
             ("StructSize", 0), ("RingPoints", 4), ("RingsPerSegment", 8), ("CalibrationFrames", 12), ("Filter", 16),
             ("FilterMinCutoffHz", 20), ("FilterBeta", 24), ("FilterDCutoffHz", 28), ("Smoothing", 32), ("Correction", 36),
-            ("Prediction", 40), ("JitterRadiusM", 44), ("MaxDeviationM", 48), ("TeleportDistanceM", 52));
+            ("Prediction", 40), ("JitterRadiusM", 44), ("MaxDeviationM", 48), ("TeleportDistanceM", 52),
+            ("ProxyRule", 56), ("Reserved", 60));
 
         [Fact]
         public void BodyShape_Is48() => AssertLayout<BodyShape>(48,
@@ -158,11 +159,21 @@ namespace Drape.Tests
         }
 
         [Fact]
-        public void FrameStats_Is64() => AssertLayout<FrameStats>(64,
+        public void FrameStats_Is72() => AssertLayout<FrameStats>(72,
             ("StructSize", 0), ("FramesPushed", 4), ("FramesAccepted", 8), ("FramesRejected", 12), ("FramesDropped", 16),
             ("Updates", 20), ("Teleports", 24), ("Teleported", 28), ("Calibrated", 29), ("Reserved0", 30),
-            ("Reserved1", 31), ("LastTimestampS", 32), ("SkeletonMs", 40), ("BodyMs", 48), ("BodyVolumeL", 56),
-            ("Reserved2", 60));
+            ("Reserved1", 31), ("LastTimestampS", 32), ("SkeletonMs", 40), ("BodyMs", 48), ("ProxiesMs", 56),
+            ("BodyVolumeL", 64), ("Reserved2", 68));
+
+        [Fact]
+        public void Ellipsoid_Is68() => AssertLayout<Ellipsoid>(68,
+            ("Centre", 0), ("AxisX", 12), ("AxisY", 24), ("AxisZ", 36), ("Radii", 48), ("Chain", 60), ("Ring", 64));
+
+        [Fact]
+        public void ProxyFidelity_Is40() => AssertLayout<ProxyFidelity>(40,
+            ("StructSize", 0), ("UnionSamples", 4), ("BodyToProxyMeanMm", 8), ("BodyToProxyP95Mm", 12),
+            ("BodyToProxyMaxMm", 16), ("ProxyToBodyMeanMm", 20), ("ProxyToBodyP95Mm", 24), ("ProxyToBodyMaxMm", 28),
+            ("OutsideFraction", 32), ("Reserved", 36));
 
         [Fact]
         public void RecordingInfo_Is32() => AssertLayout<RecordingInfo>(32,
@@ -173,6 +184,7 @@ namespace Drape.Tests
         {
             new object[] { "drape_result", typeof(ResultCode) },
             new object[] { "drape_layout", typeof(Layout) },
+            new object[] { "drape_proxy_rule", typeof(ProxyRule) },
             new object[] { "drape_tracking_state", typeof(TrackingState) },
             new object[] { "drape_filter", typeof(Filter) },
             new object[] { "drape_sex", typeof(Sex) },

@@ -180,6 +180,46 @@ namespace Drape
 
         // ---- Statistics --------------------------------------------------------------------------
 
+        /// <summary>Number of tracking ellipsoids (fixed for a context).</summary>
+        public int GetEllipsoidCount()
+        {
+            IntPtr h = Live;
+            uint n = 0;
+            DrapeException.Check(Native.drape_context_get_ellipsoid_count(h, &n));
+            return (int)n;
+        }
+
+        /// <summary>Copies the tracking ellipsoids of the last update; returns how many were written.</summary>
+        public int ReadEllipsoids(Span<Ellipsoid> ellipsoids)
+        {
+            IntPtr h = Live;
+            uint count = 0;
+            fixed (Ellipsoid* p = ellipsoids)
+                DrapeException.Check(Native.drape_context_read_ellipsoids(h, p, (uint)ellipsoids.Length, &count));
+            return (int)count;
+        }
+
+        /// <summary>Copies the ellipsoids as 4x4 column-major matrices (16 floats each, unit sphere to
+        /// ellipsoid); returns how many matrices were written.</summary>
+        public int ReadEllipsoidMatrices(Span<float> matrices)
+        {
+            IntPtr h = Live;
+            uint count = 0;
+            fixed (float* p = matrices)
+                DrapeException.Check(Native.drape_context_read_ellipsoid_matrices(h, p, (uint)(matrices.Length / 16), &count));
+            return (int)count;
+        }
+
+        /// <summary>Measures how closely the ellipsoids follow the body mesh (a diagnostic, ~ms).</summary>
+        public ProxyFidelity MeasureProxyFidelity()
+        {
+            IntPtr h = Live;
+            ProxyFidelity f = default;
+            f.StructSize = (uint)sizeof(ProxyFidelity);
+            DrapeException.Check(Native.drape_context_measure_proxy_fidelity(h, &f));
+            return f;
+        }
+
         /// <summary>Counters and timings (drape_context_get_frame_stats).</summary>
         public FrameStats GetFrameStats()
         {

@@ -99,6 +99,20 @@ namespace Drape
         // ---- Statistics ------------------------------------------------------------------------
 
         [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_get_ellipsoid_count(IntPtr context, uint* outCount);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_read_ellipsoids(IntPtr context, Ellipsoid* ellipsoids,
+            uint capacity, uint* outCount);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_read_ellipsoid_matrices(IntPtr context, float* matrices,
+            uint capacity, uint* outCount);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_measure_proxy_fidelity(IntPtr context, ProxyFidelity* outFidelity);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
         internal static extern ResultCode drape_context_get_frame_stats(IntPtr context, FrameStats* outStats);
 
         // ---- Recordings ------------------------------------------------------------------------

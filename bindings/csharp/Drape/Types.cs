@@ -79,6 +79,15 @@ namespace Drape
         DoubleExponential = 2,
     }
 
+    /// <summary>drape_proxy_rule: how the tracking ellipsoids are built.</summary>
+    public enum ProxyRule : int
+    {
+        /// <summary>DRAPE_PROXY_RULE_PAPER: the paper's eq. 5-6 (per torso ring, one per limb bone).</summary>
+        Paper = 0,
+        /// <summary>DRAPE_PROXY_RULE_DRAPE: per ring and sub-ring, sized to close the gaps; the default.</summary>
+        Drape = 1,
+    }
+
     /// <summary>drape_sex.</summary>
     public enum Sex : int
     {
@@ -182,7 +191,7 @@ namespace Drape
         public override string ToString() => $"{Position} {TrackingState}";
     }
 
-    /// <summary>drape_context_desc (56 bytes). Start from <see cref="CreateDefault"/>, which
+    /// <summary>drape_context_desc (64 bytes). Start from <see cref="CreateDefault"/>, which
     /// sets <see cref="StructSize"/> and the library's defaults, then change what you need.</summary>
     [StructLayout(LayoutKind.Sequential)]
     public struct ContextDesc
@@ -215,6 +224,10 @@ namespace Drape
         public float MaxDeviationM;
         /// <summary>teleport_distance_m: pelvis jump reported as a teleport, (0, 100]; 0.5.</summary>
         public float TeleportDistanceM;
+        /// <summary>proxy_rule (int32_t in C); default <see cref="Drape.ProxyRule.Drape"/>.</summary>
+        public ProxyRule ProxyRule;
+        /// <summary>reserved: 0.</summary>
+        public uint Reserved;
 
         /// <summary>The library's defaults (drape_context_desc_init).</summary>
         public static unsafe ContextDesc CreateDefault()
@@ -281,7 +294,7 @@ namespace Drape
         public Quaternionf* Orientations;
     }
 
-    /// <summary>drape_frame_stats (64 bytes).</summary>
+    /// <summary>drape_frame_stats (72 bytes).</summary>
     [StructLayout(LayoutKind.Sequential)]
     public struct FrameStats
     {
@@ -313,6 +326,8 @@ namespace Drape
         public double SkeletonMs;
         /// <summary>body_ms: wall time of the last update's ring + mesh stage.</summary>
         public double BodyMs;
+        /// <summary>proxies_ms: wall time of the last update's tracking-ellipsoid stage.</summary>
+        public double ProxiesMs;
         /// <summary>body_volume_l: enclosed volume of the body mesh after the last update.</summary>
         public float BodyVolumeL;
         /// <summary>reserved2.</summary>
@@ -342,5 +357,52 @@ namespace Drape
         public float NominalRateHz;
         /// <summary>duration_s.</summary>
         public double DurationS;
+    }
+
+    /// <summary>drape_ellipsoid (68 bytes): one tracking ellipsoid. A world point p is inside when
+    /// |diag(1/Radii) * [AxisX AxisY AxisZ]^T (p - Centre)| &lt; 1.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct Ellipsoid
+    {
+        /// <summary>centre (metres).</summary>
+        public Vector3f Centre;
+        /// <summary>axis_x: body forward (limbs: carried along the limb without twist).</summary>
+        public Vector3f AxisX;
+        /// <summary>axis_y: along the bone.</summary>
+        public Vector3f AxisY;
+        /// <summary>axis_z: AxisX x AxisY.</summary>
+        public Vector3f AxisZ;
+        /// <summary>radii: semi-axes along AxisX, AxisY, AxisZ (metres).</summary>
+        public Vector3f Radii;
+        /// <summary>chain: 0 torso, 1 neck and head, 2 left arm, 3 right arm, 4 left leg, 5 right leg.</summary>
+        public int Chain;
+        /// <summary>ring: the feature ring it was built from.</summary>
+        public int Ring;
+    }
+
+    /// <summary>drape_proxy_fidelity (40 bytes): how closely the ellipsoids follow the body mesh.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct ProxyFidelity
+    {
+        /// <summary>struct_size: sizeof(drape_proxy_fidelity); set by the reading method.</summary>
+        public uint StructSize;
+        /// <summary>union_samples: surface points of the union measured.</summary>
+        public uint UnionSamples;
+        /// <summary>body_to_proxy_mean_mm: body vertices' distance outside the union (mean).</summary>
+        public float BodyToProxyMeanMm;
+        /// <summary>body_to_proxy_p95_mm.</summary>
+        public float BodyToProxyP95Mm;
+        /// <summary>body_to_proxy_max_mm.</summary>
+        public float BodyToProxyMaxMm;
+        /// <summary>proxy_to_body_mean_mm: the union's distance outside the body (mean).</summary>
+        public float ProxyToBodyMeanMm;
+        /// <summary>proxy_to_body_p95_mm.</summary>
+        public float ProxyToBodyP95Mm;
+        /// <summary>proxy_to_body_max_mm.</summary>
+        public float ProxyToBodyMaxMm;
+        /// <summary>outside_fraction: body vertices outside every ellipsoid by more than 0.5 mm.</summary>
+        public float OutsideFraction;
+        /// <summary>reserved.</summary>
+        public float Reserved;
     }
 }

@@ -1,0 +1,180 @@
+#include "proxies/proxy_builder.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace drape {
+
+namespace {
+
+// Drape rule: an ellipsoid per ring reaching kOverlap x the ring spacing along the chain. Between
+// two rings d apart, each ellipsoid's cross-section at d/2 is sqrt(1 - 1/(4 kOverlap^2)) of its
+// ring (0.943 for 1.5); scaling the cross-section by 2 / (1 + that) balances the bulge at the
+// ring against the dip half-way (+-2.9 % of the radius).
+constexpr float kOverlap = 1.5f;
+const float kMidFactor = std::sqrt(1.0f - 1.0f / (4.0f * kOverlap * kOverlap));
+const float kSectionScale = 2.0f / (1.0f + kMidFactor);
+// Sub-rings keep ellipsoids no further apart than this times the local radius, which bounds how
+// far an ellipsoid reaches past a bend or a chain end.
+constexpr float kMaxSpacingOverRadius = 1.0f;
+const float kCosBend = std::cos(25.0f * kPi / 180.0f);
+
+struct ChainBones {
+  int count;
+  Joint joints[4];
+};
+constexpr ChainBones kLimbJoints[4] = {
+    {4, {Joint::ShoulderL, Joint::ElbowL, Joint::WristL, Joint::HandL}},
+    {4, {Joint::ShoulderR, Joint::ElbowR, Joint::WristR, Joint::HandR}},
+    {4, {Joint::HipL, Joint::KneeL, Joint::AnkleL, Joint::FootL}},
+    {4, {Joint::HipR, Joint::KneeR, Joint::AnkleR, Joint::FootR}},
+};
+
+float ringSpacing(const BodyModel& body, int first, int count, int i) {
+  const auto& rings = body.rings();
+  float h = 0.0f;
+  if (i > 0) h = std::max(h, (rings[first + i].centre - rings[first + i - 1].centre).norm());
+  if (i + 1 < count) h = std::max(h, (rings[first + i + 1].centre - rings[first + i].centre).norm());
+  return std::max(h, 1e-3f);  // a collapsed chain still gets a finite, valid ellipsoid
+}
+
+}  // namespace
+
+void ProxyBuilder::planSubRings(const BodyModel& body) {
+  // Decided once, on the rings as first built, so the ellipsoid count never changes.
+  const auto& rings = body.rings();
+  subRings_.assign(rings.size(), 0);
+  for (int c = 0; c < kChainCount; ++c) {
+    const int first = body.chainFirstRing(static_cast<Chain>(c)), n = body.chainRingCount(static_cast<Chain>(c));
+    for (int i = 0; i + 1 < n; ++i) {
+      const RingPose& a = rings[first + i];
+      const RingPose& b = rings[first + i + 1];
+      const float radius = std::min(std::min(a.forward_m, a.side_m), std::min(b.forward_m, b.side_m));
+      const float d = (b.centre - a.centre).norm();
+      const int subs = static_cast<int>(std::ceil(d / (kMaxSpacingOverRadius * std::max(radius, 1e-3f)))) - 1;
+      subRings_[static_cast<size_t>(first + i)] = std::clamp(subs, 0, 8);
+    }
+  }
+  size_t total = 0;
+  for (int s : subRings_) total += static_cast<size_t>(s) + 1;
+  scratch_.resize(total);
+  scratchRing_.resize(total);
+}
+
+void ProxyBuilder::add(const Ellipsoid& e, const ProxySource& s) {
+  if (count_ < ellipsoids_.size()) {
+    ellipsoids_[count_] = e;
+    sources_[count_] = s;
+  } else {
+    ellipsoids_.push_back(e);
+    sources_.push_back(s);
+  }
+  ellipsoids_[count_].refresh();
+  ++count_;
+}
+
+void ProxyBuilder::build(const BodyModel& body, const SkeletonPose& pose) {
+  count_ = 0;
+  if (subRings_.empty()) planSubRings(body);
+  const auto& rings = body.rings();
+  const bool paper = rule_ == ProxyRule::Paper;
+
+  for (int c = 0; c < kChainCount; ++c) {
+    const Chain chain = static_cast<Chain>(c);
+    const int first = body.chainFirstRing(chain), n = body.chainRingCount(chain);
+    const bool limb = chain != Chain::Torso && chain != Chain::Head;
+    if (paper && limb) {
+      // One ellipsoid per bone (paper): centred at the bone's midpoint along it.
+      const ChainBones& cb = kLimbJoints[c - static_cast<int>(Chain::ArmL)];
+      for (int k = 0; k + 1 < cb.count; ++k) {
+        const Vec3& a = pose.position[idx(cb.joints[k])];
+        const Vec3& b = pose.position[idx(cb.joints[k + 1])];
+        float radius = 0.0f;
+        int ringOnBone = -1;
+        for (int i = 0; i < n; ++i) {
+          const float u = body.stations()[first + i].u;
+          if (u >= static_cast<float>(k) && u <= static_cast<float>(k + 1)) {
+            radius = std::max(radius, 0.5f * (rings[first + i].forward_m + rings[first + i].side_m));
+            if (ringOnBone < 0) ringOnBone = first + i;
+          }
+        }
+        if (ringOnBone < 0) ringOnBone = first;
+        Ellipsoid e;
+        e.centre = 0.5f * (a + b);
+        e.rotation = rings[ringOnBone].frame;
+        const Vec3 dir = b - a;
+        if (dir.norm() > 1e-6f) {
+          // Align the frame's y with this bone exactly (the ring may sit at the bone's end).
+          const Quat q = Quat::FromTwoVectors(e.rotation.col(1), dir.normalized());
+          e.rotation = (q.toRotationMatrix() * e.rotation).eval();
+        }
+        e.radii = Vec3(std::max(radius, 1e-3f), std::max(0.5f * dir.norm(), 1e-3f), std::max(radius, 1e-3f));
+        add(e, {chain, ringOnBone, k});
+      }
+      continue;
+    }
+    if (paper) {
+      // One ellipsoid per ring (paper eq. 5): (L_l, H, L_s), H = the larger neighbour spacing.
+      for (int i = 0; i < n; ++i) {
+        const RingPose& r = rings[first + i];
+        Ellipsoid e;
+        e.centre = r.centre;
+        e.rotation = r.frame;
+        e.radii = Vec3(r.forward_m, ringSpacing(body, first, n, i), r.side_m);
+        add(e, {chain, first + i, -1});
+      }
+      continue;
+    }
+    // Drape rule: ellipsoids at the rings and at sub-rings interpolated between them, so that no
+    // two are further apart than kMaxSpacingOverRadius x the smaller radius; each reaches
+    // kOverlap x its spacing along the chain (chain ends: 1 x, so they do not overshoot).
+    int emitted = 0;
+    for (int i = 0; i < n; ++i) {
+      const RingPose& r = rings[first + i];
+      const int subs = i + 1 < n ? subRings_[static_cast<size_t>(first + i)] : 0;
+      for (int k = 0; k <= subs; ++k) {
+        const float f = static_cast<float>(k) / static_cast<float>(subs + 1);
+        RingPose v = r;
+        if (k > 0) {
+          const RingPose& r2 = rings[first + i + 1];
+          v.centre = (1.0f - f) * r.centre + f * r2.centre;
+          const Quat qa(r.frame), qb(r2.frame);
+          v.frame = qa.slerp(f, qb).toRotationMatrix();
+          v.forward_m = (1.0f - f) * r.forward_m + f * r2.forward_m;
+          v.side_m = (1.0f - f) * r.side_m + f * r2.side_m;
+        }
+        scratchRing_[static_cast<size_t>(emitted)] = first + i;
+        scratch_[static_cast<size_t>(emitted++)] = v;
+      }
+    }
+    for (int i = 0; i < emitted; ++i) {
+      const RingPose& v = scratch_[static_cast<size_t>(i)];
+      float spacing = 0.0f;
+      if (i > 0) spacing = std::max(spacing, (v.centre - scratch_[static_cast<size_t>(i - 1)].centre).norm());
+      if (i + 1 < emitted) spacing = std::max(spacing, (scratch_[static_cast<size_t>(i + 1)].centre - v.centre).norm());
+      spacing = std::max(spacing, 1e-3f);
+      // Chain ends and bends (a neighbour more than kBendDeg off this ring's axis) reach only to
+      // their neighbour: a longer reach would stick out past the end or the corner.
+      bool end = i == 0 || i + 1 == emitted;
+      const Vec3 axis = v.frame.col(1);
+      for (int nb : {i - 1, i + 1}) {
+        if (nb < 0 || nb >= emitted) continue;
+        const Vec3 toNb = scratch_[static_cast<size_t>(nb)].centre - v.centre;
+        const float len = toNb.norm();
+        if (len > 1e-6f && std::fabs(axis.dot(toNb)) < kCosBend * len) end = true;
+      }
+      const float reach = end ? spacing : kOverlap * spacing;
+      const float section = end ? 1.0f : kSectionScale;
+      Ellipsoid e;
+      e.centre = v.centre;
+      e.rotation = v.frame;
+      e.radii = Vec3(section * v.forward_m, reach, section * v.side_m);
+      add(e, {chain, scratchRing_[static_cast<size_t>(i)], -1});
+    }
+  }
+  // ellipsoids_ never shrinks (no allocation per frame); the live count is count_.
+  ellipsoids_.resize(count_);
+  sources_.resize(count_);
+}
+
+}  // namespace drape

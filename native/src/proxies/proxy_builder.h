@@ -1,0 +1,55 @@
+// Tracking ellipsoids built from the body's feature rings every frame (paper §3.2, eq. 5-6).
+//
+// Two construction rules, selectable so their fidelity and cost can be compared:
+//  - Paper: one ellipsoid per torso/neck/head ring with semi-axes (L_l, H, L_s), H = the larger
+//    distance to the neighbouring ring centres; one ellipsoid per limb bone, centred at the bone's
+//    midpoint, long semi-axis = half the bone, the other two = the largest mean ring radius on
+//    that bone.
+//  - Drape (default): one ellipsoid per ring and per sub-ring interpolated where rings are
+//    further apart than the local radius; long semi-axis = kOverlap x the larger neighbour
+//    spacing and cross-section scaled so the union neither dips between rings nor bulges at them
+//    by more than ~3 %; chain ends and bends reach only to their neighbour (docs/proxies.md has
+//    the derivation and the measured before/after).
+#pragma once
+
+#include "body/body_model.h"
+#include "proxies/ellipsoid.h"
+
+#include <vector>
+
+namespace drape {
+
+enum class ProxyRule : int { Paper = 0, Drape = 1 };  // ABI-visible values
+
+struct ProxySource {
+  Chain chain = Chain::Torso;
+  int first_ring = 0;  // ring (or first ring of the bone) it was built from
+  int bone = -1;       // bone of the chain for per-bone ellipsoids, else -1
+};
+
+class ProxyBuilder {
+ public:
+  explicit ProxyBuilder(ProxyRule rule = ProxyRule::Drape) : rule_(rule) {}
+  ProxyRule rule() const { return rule_; }
+
+  // Rebuilds every ellipsoid from the body's current rings and the pose. The count and order
+  // depend only on the rule and the body's topology, so they are stable from frame to frame.
+  // No allocation after the first call.
+  void build(const BodyModel& body, const SkeletonPose& pose);
+
+  const std::vector<Ellipsoid>& ellipsoids() const { return ellipsoids_; }
+  const std::vector<ProxySource>& sources() const { return sources_; }
+
+ private:
+  void add(const Ellipsoid& e, const ProxySource& s);
+  void planSubRings(const BodyModel& body);
+  std::vector<int> subRings_;        // per ring: sub-rings inserted before the next ring
+  std::vector<RingPose> scratch_;    // one chain's rings and sub-rings
+  std::vector<int> scratchRing_;     // the ring each of them belongs to
+  ProxyRule rule_;
+  std::vector<Ellipsoid> ellipsoids_;
+  std::vector<ProxySource> sources_;
+  size_t count_ = 0;
+};
+
+}  // namespace drape
