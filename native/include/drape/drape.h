@@ -60,7 +60,7 @@ typedef enum drape_result {
   DRAPE_ERROR_INVALID_ARGUMENT = 2,  /* a value is malformed (bad struct_size, bad combination) */
   DRAPE_ERROR_INVALID_HANDLE = 3,    /* the handle is not a live object of the expected kind */
   DRAPE_ERROR_BUFFER_TOO_SMALL = 4,  /* capacity below the size query's answer; nothing written */
-  DRAPE_ERROR_NONFINITE = 5,         /* a NaN or Inf (or absurdly large) number was passed */
+  DRAPE_ERROR_NONFINITE = 5,         /* a NaN or Inf number was passed */
   DRAPE_ERROR_OUT_OF_RANGE = 6,      /* a number or enum is outside its documented range */
   DRAPE_ERROR_CALL_ORDER = 7,        /* the call needs an earlier one (e.g. read before update) */
   DRAPE_ERROR_TIMESTAMP = 8,         /* a frame's timestamp is not after the previous frame's */
@@ -155,7 +155,7 @@ typedef struct drape_context_desc {
                                     frame's dt) is reported as a teleport; (0, 100]; 0.5 */
   int32_t proxy_rule;            /* drape_proxy_rule: how tracking ellipsoids are built;
                                     default DRAPE_PROXY_RULE_DRAPE */
-  uint32_t reserved;             /* 0 */
+  uint32_t reserved;             /* must be 0 (else DRAPE_ERROR_INVALID_ARGUMENT) */
 } drape_context_desc;
 
 /* Fills `desc` with defaults and struct_size. */
@@ -217,7 +217,7 @@ typedef struct drape_skeleton_frame {
   uint32_t struct_size;            /* sizeof(drape_skeleton_frame) */
   int32_t layout;                  /* drape_layout (not AUTO) */
   uint32_t joint_count;            /* must equal the layout's joint count (20, 25, 32) */
-  uint32_t reserved;               /* 0 */
+  uint32_t reserved;               /* must be 0 (else DRAPE_ERROR_INVALID_ARGUMENT) */
   double timestamp_s;              /* strictly increasing from frame to frame */
   const drape_joint* joints;       /* joint_count joints, in the layout's order */
   const drape_quat* orientations;  /* optional (NULL): joint_count unit quaternions; validated
@@ -304,7 +304,7 @@ DRAPE_API drape_result DRAPE_CALL drape_context_read_ellipsoid_matrices(drape_co
 
 /* How closely the ellipsoids follow the body mesh of the last update (docs/proxies.md):
  * body -> proxies is each body vertex's distance outside the union of ellipsoids (0 inside);
- * proxies -> body is the distance from points on the union's surface to the body surface. */
+ * proxies -> body is how far points on the union's surface lie outside the body (0 inside). */
 typedef struct drape_proxy_fidelity {
   uint32_t struct_size;          /* caller sets sizeof(drape_proxy_fidelity) */
   uint32_t union_samples;        /* surface points of the union measured */

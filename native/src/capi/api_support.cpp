@@ -1,17 +1,24 @@
 #include "capi/api_support.h"
 
+#include <cstring>
 #include <mutex>
-#include <unordered_set>
+#include <unordered_map>
 
 namespace drape::api {
 
 namespace {
 
 thread_local std::string t_lastError;
+thread_local const char* t_currentFunction = nullptr;
 
 struct Registry {
   std::mutex mutex;
-  std::unordered_set<const void*> live[2];
+  uintptr_t next = 0;  // tokens are (++next) << 4: never 0, never reused (2^60 creates on 64-bit)
+  struct Entry {
+    HandleKind kind;
+    void* object;
+  };
+  std::unordered_map<uintptr_t, Entry> live;
 };
 
 Registry& registry() {
@@ -21,32 +28,46 @@ Registry& registry() {
 
 }  // namespace
 
+void setCurrentFunction(const char* function) { t_currentFunction = function; }
+
 drape_result fail(drape_result result, const std::string& message) {
   try {
-    t_lastError = message;
+    const char* fn = t_currentFunction;
+    if (fn && message.compare(0, std::strlen(fn), fn) != 0)
+      t_lastError = std::string(fn) + ": " + message;
+    else
+      t_lastError = message;
   } catch (...) {
     // Could not allocate the message: keep the code, which is what callers act on.
   }
   return result;
 }
 
-void registerHandle(HandleKind kind, const void* handle) {
+void* registerHandle(HandleKind kind, void* object) {
   Registry& r = registry();
   std::lock_guard<std::mutex> lock(r.mutex);
-  r.live[static_cast<int>(kind)].insert(handle);
+  const uintptr_t token = (++r.next) << 4;
+  r.live.emplace(token, Registry::Entry{kind, object});
+  return reinterpret_cast<void*>(token);
 }
 
-void unregisterHandle(HandleKind kind, const void* handle) {
+void* resolveHandle(HandleKind kind, const void* token) {
+  if (!token) return nullptr;
   Registry& r = registry();
   std::lock_guard<std::mutex> lock(r.mutex);
-  r.live[static_cast<int>(kind)].erase(handle);
+  const auto it = r.live.find(reinterpret_cast<uintptr_t>(token));
+  return (it != r.live.end() && it->second.kind == kind) ? it->second.object : nullptr;
 }
 
-bool isLiveHandle(HandleKind kind, const void* handle) {
-  if (!handle) return false;
+void* unregisterHandle(HandleKind kind, const void* token) {
+  if (!token) return nullptr;
   Registry& r = registry();
   std::lock_guard<std::mutex> lock(r.mutex);
-  return r.live[static_cast<int>(kind)].count(handle) != 0;
+  const auto it = r.live.find(reinterpret_cast<uintptr_t>(token));
+  if (it == r.live.end() || it->second.kind != kind) return nullptr;
+  void* object = it->second.object;
+  r.live.erase(it);
+  return object;
 }
 
 drape_result checkStructSize(uint32_t struct_size, size_t min_size, const char* what) {

@@ -16,10 +16,20 @@ drape_result fail(drape_result result, const std::string& message);
 // Clears nothing: a success leaves the last error of an earlier failure readable.
 inline drape_result ok() { return DRAPE_OK; }
 
+// Handles are opaque tokens, not addresses: each create hands out a value never used before, so a
+// destroyed handle stays invalid even when the allocator gives its memory to a new object, and a
+// context token is never a valid recording token. Tokens are never dereferenced.
 enum class HandleKind { Context, Recording };
-void registerHandle(HandleKind kind, const void* handle);
-void unregisterHandle(HandleKind kind, const void* handle);
-bool isLiveHandle(HandleKind kind, const void* handle);
+// Registers `object` and returns its token. Throws std::bad_alloc only (caught by guarded()).
+void* registerHandle(HandleKind kind, void* object);
+// The object behind a live token of this kind, or nullptr.
+void* resolveHandle(HandleKind kind, const void* token);
+// Forgets a live token and returns its object (nullptr if the token is not live).
+void* unregisterHandle(HandleKind kind, const void* token);
+
+// The entry point now running on this thread (set by guarded()); fail() prefixes it to messages
+// that do not already name it.
+void setCurrentFunction(const char* function);
 
 // Validates the struct_size field of a caller struct: at least the first released size.
 const char* lastError();
@@ -32,6 +42,7 @@ inline bool finite(double v) { return std::isfinite(v); }
 // Runs `body` (returning drape_result), mapping exceptions to result codes.
 template <typename F>
 drape_result guarded(const char* function, F&& body) noexcept {
+  setCurrentFunction(function);
   try {
     return body();
   } catch (const std::bad_alloc&) {

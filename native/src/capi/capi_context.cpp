@@ -4,20 +4,19 @@
 
 #include <algorithm>
 #include <cstring>
+#include <memory>
 
 using drape::Context;
 using namespace drape::api;
 
 namespace {
 
-Context* asContext(drape_context* handle) { return reinterpret_cast<Context*>(handle); }
-
-#define DRAPE_CHECK_CONTEXT(fn, handle)                                                        \
-  do {                                                                                         \
-    if (!(handle)) return fail(DRAPE_ERROR_NULL_ARGUMENT, fn ": context is NULL");             \
-    if (!isLiveHandle(HandleKind::Context, handle))                                            \
-      return fail(DRAPE_ERROR_INVALID_HANDLE, fn ": context is not a live drape_context (destroyed or never created)"); \
-  } while (0)
+// Resolves the handle into `self` (declared by the macro) or returns the error.
+#define DRAPE_CHECK_CONTEXT(fn, handle)                                                          \
+  if (!(handle)) return fail(DRAPE_ERROR_NULL_ARGUMENT, fn ": context is NULL");                 \
+  Context* const self = static_cast<Context*>(resolveHandle(HandleKind::Context, handle));      \
+  if (!self)                                                                                     \
+    return fail(DRAPE_ERROR_INVALID_HANDLE, fn ": context is not a live drape_context (destroyed or never created)")
 
 drape_result toShapeInput(const drape_body_shape& s, drape::BodyShapeInput& in) {
   in.sex = static_cast<drape::Sex>(s.sex);
@@ -71,9 +70,10 @@ DRAPE_API drape_result DRAPE_CALL drape_context_create(const drape_context_desc*
     }
     std::string err;
     if (drape_result r = drape::validateContextDesc(d, err)) return fail(r, "drape_context_create: " + err);
-    auto* ctx = new Context(d);
-    registerHandle(HandleKind::Context, ctx);
-    *out_context = reinterpret_cast<drape_context*>(ctx);
+    auto ctx = std::make_unique<Context>(d);
+    void* token = registerHandle(HandleKind::Context, ctx.get());
+    ctx.release();  // owned by the registry entry until drape_context_destroy
+    *out_context = static_cast<drape_context*>(token);
     return DRAPE_OK;
   });
 }
@@ -81,10 +81,9 @@ DRAPE_API drape_result DRAPE_CALL drape_context_create(const drape_context_desc*
 DRAPE_API drape_result DRAPE_CALL drape_context_destroy(drape_context* context) {
   return guarded("drape_context_destroy", [&]() -> drape_result {
     if (!context) return DRAPE_OK;
-    if (!isLiveHandle(HandleKind::Context, context))
-      return fail(DRAPE_ERROR_INVALID_HANDLE, "drape_context_destroy: context is not a live drape_context");
-    unregisterHandle(HandleKind::Context, context);
-    delete asContext(context);
+    auto* ctx = static_cast<Context*>(unregisterHandle(HandleKind::Context, context));
+    if (!ctx) return fail(DRAPE_ERROR_INVALID_HANDLE, "drape_context_destroy: context is not a live drape_context");
+    delete ctx;
     return DRAPE_OK;
   });
 }
@@ -109,7 +108,7 @@ DRAPE_API drape_result DRAPE_CALL drape_context_set_body_shape(drape_context* co
     drape::BodyShapeInput in;
     if (drape_result r = toShapeInput(*shape, in)) return r;
     std::string err;
-    if (drape_result r = asContext(context)->setShape(in, err)) return fail(r, "drape_context_set_body_shape: " + err);
+    if (drape_result r = self->setShape(in, err)) return fail(r, "drape_context_set_body_shape: " + err);
     return DRAPE_OK;
   });
 }
@@ -120,7 +119,7 @@ DRAPE_API drape_result DRAPE_CALL drape_context_get_body_shape(drape_context* co
     DRAPE_CHECK_CONTEXT("drape_context_get_body_shape", context);
     if (!out_shape) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_get_body_shape: out_shape is NULL");
     if (drape_result r = checkStructSize(out_shape->struct_size, sizeof(drape_body_shape), "drape_body_shape")) return r;
-    const drape::ResolvedShape& s = asContext(context)->shape();
+    const drape::ResolvedShape& s = self->shape();
     drape_body_shape o;
     std::memset(&o, 0, sizeof(o));
     o.struct_size = sizeof(drape_body_shape);
@@ -142,15 +141,15 @@ DRAPE_API drape_result DRAPE_CALL drape_context_push_skeleton(drape_context* con
   return guarded("drape_context_push_skeleton", [&]() -> drape_result {
     DRAPE_CHECK_CONTEXT("drape_context_push_skeleton", context);
     if (!frame) {
-      asContext(context)->countRejectedFrame();
+      self->countRejectedFrame();
       return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_push_skeleton: frame is NULL");
     }
     if (drape_result r = checkStructSize(frame->struct_size, sizeof(drape_skeleton_frame), "drape_skeleton_frame")) {
-      asContext(context)->countRejectedFrame();
+      self->countRejectedFrame();
       return r;
     }
     std::string err;
-    if (drape_result r = asContext(context)->pushFrame(*frame, err))
+    if (drape_result r = self->pushFrame(*frame, err))
       return fail(r, "drape_context_push_skeleton: " + err);
     return DRAPE_OK;
   });
@@ -160,7 +159,7 @@ DRAPE_API drape_result DRAPE_CALL drape_context_update(drape_context* context) {
   return guarded("drape_context_update", [&]() -> drape_result {
     DRAPE_CHECK_CONTEXT("drape_context_update", context);
     std::string err;
-    if (drape_result r = asContext(context)->update(err)) return fail(r, "drape_context_update: " + err);
+    if (drape_result r = self->update(err)) return fail(r, "drape_context_update: " + err);
     return DRAPE_OK;
   });
 }
@@ -173,7 +172,7 @@ DRAPE_API drape_result DRAPE_CALL drape_context_read_skeleton(drape_context* con
     if (capacity < static_cast<uint32_t>(drape::kJointCount))
       return fail(DRAPE_ERROR_BUFFER_TOO_SMALL, "drape_context_read_skeleton: capacity " + std::to_string(capacity) +
                                                     " is below 21 joints");
-    Context* ctx = asContext(context);
+    Context* ctx = self;
     if (!ctx->hasUpdate())
       return fail(DRAPE_ERROR_CALL_ORDER, "drape_context_read_skeleton: no update has run yet");
     const auto& pose = ctx->tracker().pose();
@@ -191,7 +190,7 @@ DRAPE_API drape_result DRAPE_CALL drape_context_get_body_mesh_size(drape_context
     DRAPE_CHECK_CONTEXT("drape_context_get_body_mesh_size", context);
     if (!out_vertex_count && !out_index_count)
       return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_get_body_mesh_size: both out pointers are NULL");
-    const drape::BodyModel& body = asContext(context)->body();
+    const drape::BodyModel& body = self->body();
     if (out_vertex_count) *out_vertex_count = static_cast<uint32_t>(body.positions().size());
     if (out_index_count) *out_index_count = static_cast<uint32_t>(body.indices().size());
     return DRAPE_OK;
@@ -205,7 +204,7 @@ DRAPE_API drape_result DRAPE_CALL drape_context_read_body_mesh(drape_context* co
     DRAPE_CHECK_CONTEXT("drape_context_read_body_mesh", context);
     if (!positions && !normals && !indices)
       return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_read_body_mesh: positions, normals and indices are all NULL");
-    Context* ctx = asContext(context);
+    Context* ctx = self;
     const drape::BodyModel& body = ctx->body();
     const size_t nv = body.positions().size(), ni = body.indices().size();
     // Check everything before writing anything.
@@ -244,7 +243,7 @@ DRAPE_API drape_result DRAPE_CALL drape_context_get_frame_stats(drape_context* c
     drape_frame_stats s;
     std::memset(&s, 0, sizeof(s));
     s.struct_size = sizeof(drape_frame_stats);
-    asContext(context)->fillStats(s);
+    self->fillStats(s);
     *out_stats = s;
     return DRAPE_OK;
   });
@@ -254,16 +253,15 @@ DRAPE_API drape_result DRAPE_CALL drape_context_get_ellipsoid_count(drape_contex
   return guarded("drape_context_get_ellipsoid_count", [&]() -> drape_result {
     DRAPE_CHECK_CONTEXT("drape_context_get_ellipsoid_count", context);
     if (!out_count) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_get_ellipsoid_count: out_count is NULL");
-    *out_count = static_cast<uint32_t>(asContext(context)->proxies().ellipsoids().size());
+    *out_count = static_cast<uint32_t>(self->proxies().ellipsoids().size());
     return DRAPE_OK;
   });
 }
 
 namespace {
 // Shared checks of the two ellipsoid readers; returns the ellipsoids to copy or sets `r`.
-const std::vector<drape::Ellipsoid>* ellipsoidsToRead(const char* fn, drape_context* context, const void* out,
+const std::vector<drape::Ellipsoid>* ellipsoidsToRead(const char* fn, Context* ctx, const void* out,
                                                       uint32_t capacity, drape_result& r) {
-  Context* ctx = asContext(context);
   const auto& e = ctx->proxies().ellipsoids();
   if (!out) {
     r = fail(DRAPE_ERROR_NULL_ARGUMENT, std::string(fn) + ": output buffer is NULL");
@@ -286,9 +284,9 @@ DRAPE_API drape_result DRAPE_CALL drape_context_read_ellipsoids(drape_context* c
   return guarded("drape_context_read_ellipsoids", [&]() -> drape_result {
     DRAPE_CHECK_CONTEXT("drape_context_read_ellipsoids", context);
     drape_result r = DRAPE_OK;
-    const auto* e = ellipsoidsToRead("drape_context_read_ellipsoids", context, ellipsoids, capacity, r);
+    const auto* e = ellipsoidsToRead("drape_context_read_ellipsoids", self, ellipsoids, capacity, r);
     if (!e) return r;
-    const auto& sources = asContext(context)->proxies().sources();
+    const auto& sources = self->proxies().sources();
     for (size_t i = 0; i < e->size(); ++i) {
       const drape::Ellipsoid& el = (*e)[i];
       ellipsoids[i] = drape_ellipsoid{v3(el.centre), v3(el.rotation.col(0)), v3(el.rotation.col(1)),
@@ -305,7 +303,7 @@ DRAPE_API drape_result DRAPE_CALL drape_context_read_ellipsoid_matrices(drape_co
   return guarded("drape_context_read_ellipsoid_matrices", [&]() -> drape_result {
     DRAPE_CHECK_CONTEXT("drape_context_read_ellipsoid_matrices", context);
     drape_result r = DRAPE_OK;
-    const auto* e = ellipsoidsToRead("drape_context_read_ellipsoid_matrices", context, matrices, capacity, r);
+    const auto* e = ellipsoidsToRead("drape_context_read_ellipsoid_matrices", self, matrices, capacity, r);
     if (!e) return r;
     for (size_t i = 0; i < e->size(); ++i) {
       const drape::Ellipsoid& el = (*e)[i];
@@ -326,7 +324,7 @@ DRAPE_API drape_result DRAPE_CALL drape_context_measure_proxy_fidelity(drape_con
     if (!out) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_measure_proxy_fidelity: out is NULL");
     if (drape_result r = checkStructSize(out->struct_size, sizeof(drape_proxy_fidelity), "drape_proxy_fidelity"))
       return r;
-    Context* ctx = asContext(context);
+    Context* ctx = self;
     if (!ctx->hasUpdate())
       return fail(DRAPE_ERROR_CALL_ORDER, "drape_context_measure_proxy_fidelity: no update has run yet");
     const drape::FidelityReport f = ctx->measureFidelity();

@@ -9,14 +9,12 @@ using namespace drape::api;
 
 namespace {
 
-drape::Recording* asRecording(drape_recording* handle) { return reinterpret_cast<drape::Recording*>(handle); }
-
-#define DRAPE_CHECK_RECORDING(fn, handle)                                                      \
-  do {                                                                                         \
-    if (!(handle)) return fail(DRAPE_ERROR_NULL_ARGUMENT, fn ": recording is NULL");           \
-    if (!isLiveHandle(HandleKind::Recording, handle))                                          \
-      return fail(DRAPE_ERROR_INVALID_HANDLE, fn ": recording is not a live drape_recording"); \
-  } while (0)
+// Resolves the handle into `self` (declared by the macro) or returns the error.
+#define DRAPE_CHECK_RECORDING(fn, handle)                                                        \
+  if (!(handle)) return fail(DRAPE_ERROR_NULL_ARGUMENT, fn ": recording is NULL");               \
+  drape::Recording* const self =                                                                 \
+      static_cast<drape::Recording*>(resolveHandle(HandleKind::Recording, handle));              \
+  if (!self) return fail(DRAPE_ERROR_INVALID_HANDLE, fn ": recording is not a live drape_recording")
 
 drape_result checkLayoutHint(const char* fn, int32_t layout) {
   if (layout < DRAPE_LAYOUT_AUTO || layout > DRAPE_LAYOUT_AZURE)
@@ -36,8 +34,9 @@ drape_result codeFor(drape::RecordingError kind) {
 }
 
 drape_result adopt(std::unique_ptr<drape::Recording> rec, drape_recording** out) {
-  registerHandle(HandleKind::Recording, rec.get());
-  *out = reinterpret_cast<drape_recording*>(rec.release());
+  void* token = registerHandle(HandleKind::Recording, rec.get());
+  rec.release();  // owned by the registry entry until drape_recording_destroy
+  *out = static_cast<drape_recording*>(token);
   return DRAPE_OK;
 }
 
@@ -79,10 +78,9 @@ DRAPE_API drape_result DRAPE_CALL drape_recording_open_memory(const void* data, 
 DRAPE_API drape_result DRAPE_CALL drape_recording_destroy(drape_recording* recording) {
   return guarded("drape_recording_destroy", [&]() -> drape_result {
     if (!recording) return DRAPE_OK;
-    if (!isLiveHandle(HandleKind::Recording, recording))
-      return fail(DRAPE_ERROR_INVALID_HANDLE, "drape_recording_destroy: recording is not a live drape_recording");
-    unregisterHandle(HandleKind::Recording, recording);
-    delete asRecording(recording);
+    auto* rec = static_cast<drape::Recording*>(unregisterHandle(HandleKind::Recording, recording));
+    if (!rec) return fail(DRAPE_ERROR_INVALID_HANDLE, "drape_recording_destroy: recording is not a live drape_recording");
+    delete rec;
     return DRAPE_OK;
   });
 }
@@ -93,7 +91,7 @@ DRAPE_API drape_result DRAPE_CALL drape_recording_get_info(drape_recording* reco
     if (!out_info) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_recording_get_info: out_info is NULL");
     if (drape_result r = checkStructSize(out_info->struct_size, sizeof(drape_recording_info), "drape_recording_info"))
       return r;
-    const drape::Recording& rec = *asRecording(recording);
+    const drape::Recording& rec = *self;
     drape_recording_info info;
     std::memset(&info, 0, sizeof(info));
     info.struct_size = sizeof(info);
@@ -114,7 +112,7 @@ DRAPE_API drape_result DRAPE_CALL drape_recording_read_frame(drape_recording* re
   return guarded("drape_recording_read_frame", [&]() -> drape_result {
     DRAPE_CHECK_RECORDING("drape_recording_read_frame", recording);
     if (!joints) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_recording_read_frame: joints is NULL");
-    const drape::Recording& rec = *asRecording(recording);
+    const drape::Recording& rec = *self;
     if (index >= rec.frames.size())
       return fail(DRAPE_ERROR_OUT_OF_RANGE, "drape_recording_read_frame: index " + std::to_string(index) +
                                                 " >= frame count " + std::to_string(rec.frames.size()));
@@ -138,7 +136,7 @@ DRAPE_API drape_result DRAPE_CALL drape_recording_save(drape_recording* recordin
     if (!path) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_recording_save: path is NULL");
     std::string err;
     drape::RecordingError kind = drape::RecordingError::None;
-    if (!drape::writeDrapeRecordingFile(*asRecording(recording), path, err, &kind))
+    if (!drape::writeDrapeRecordingFile(*self, path, err, &kind))
       return fail(kind == drape::RecordingError::Io ? DRAPE_ERROR_IO : codeFor(kind), "drape_recording_save: " + err);
     return DRAPE_OK;
   });

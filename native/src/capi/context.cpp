@@ -24,7 +24,8 @@ constexpr float kMaxCoordinateM = 1000.0f;
 
 drape_result validateContextDesc(const drape_context_desc& d, std::string& err) {
   std::ostringstream s;
-  auto range = [&](const char* name, double v, double lo, double hi) {
+  // Bounds are compared as float, the type the host writes, so an edge like 0.999f is inside.
+  auto range = [&](const char* name, float v, float lo, float hi) {
     if (!std::isfinite(v)) {
       s << "context desc: " << name << " is not finite";
       return DRAPE_ERROR_NONFINITE;
@@ -39,20 +40,23 @@ drape_result validateContextDesc(const drape_context_desc& d, std::string& err) 
   if (d.ring_points < 8 || d.ring_points > 256 || d.ring_points % 4 != 0) {
     s << "context desc: ring_points = " << d.ring_points << " must be a multiple of 4 in [8, 256]";
     r = DRAPE_ERROR_OUT_OF_RANGE;
-  } else if ((r = range("rings_per_segment", d.rings_per_segment, 0, 16)) != DRAPE_OK) {
-  } else if ((r = range("calibration_frames", d.calibration_frames, 1, 100000)) != DRAPE_OK) {
+  } else if ((r = range("rings_per_segment", static_cast<float>(d.rings_per_segment), 0.0f, 16.0f)) != DRAPE_OK) {
+  } else if ((r = range("calibration_frames", static_cast<float>(d.calibration_frames), 1.0f, 100000.0f)) != DRAPE_OK) {
   } else if (d.filter < DRAPE_FILTER_NONE || d.filter > DRAPE_FILTER_DOUBLE_EXPONENTIAL) {
     s << "context desc: filter = " << d.filter << " is not a drape_filter value (0, 1, 2)";
     r = DRAPE_ERROR_OUT_OF_RANGE;
-  } else if ((r = range("filter_min_cutoff_hz", d.filter_min_cutoff_hz, 1e-3, 1000)) != DRAPE_OK) {
-  } else if ((r = range("filter_beta", d.filter_beta, 0, 1000)) != DRAPE_OK) {
-  } else if ((r = range("filter_d_cutoff_hz", d.filter_d_cutoff_hz, 1e-3, 1000)) != DRAPE_OK) {
-  } else if ((r = range("smoothing", d.smoothing, 0, 0.999)) != DRAPE_OK) {
-  } else if ((r = range("correction", d.correction, 0, 1)) != DRAPE_OK) {
-  } else if ((r = range("prediction", d.prediction, 0, 10)) != DRAPE_OK) {
-  } else if ((r = range("jitter_radius_m", d.jitter_radius_m, 0, 10)) != DRAPE_OK) {
-  } else if ((r = range("max_deviation_m", d.max_deviation_m, 0, 10)) != DRAPE_OK) {
-  } else if ((r = range("teleport_distance_m", d.teleport_distance_m, 1e-6, 100)) != DRAPE_OK) {
+  } else if ((r = range("filter_min_cutoff_hz", d.filter_min_cutoff_hz, 1e-3f, 1000.0f)) != DRAPE_OK) {
+  } else if ((r = range("filter_beta", d.filter_beta, 0.0f, 1000.0f)) != DRAPE_OK) {
+  } else if ((r = range("filter_d_cutoff_hz", d.filter_d_cutoff_hz, 1e-3f, 1000.0f)) != DRAPE_OK) {
+  } else if ((r = range("smoothing", d.smoothing, 0.0f, 0.999f)) != DRAPE_OK) {
+  } else if ((r = range("correction", d.correction, 0.0f, 1.0f)) != DRAPE_OK) {
+  } else if ((r = range("prediction", d.prediction, 0.0f, 10.0f)) != DRAPE_OK) {
+  } else if ((r = range("jitter_radius_m", d.jitter_radius_m, 0.0f, 10.0f)) != DRAPE_OK) {
+  } else if ((r = range("max_deviation_m", d.max_deviation_m, 0.0f, 10.0f)) != DRAPE_OK) {
+  } else if ((r = range("teleport_distance_m", d.teleport_distance_m, 1e-6f, 100.0f)) != DRAPE_OK) {
+  } else if (d.reserved != 0) {
+    s << "context desc: reserved must be 0";
+    r = DRAPE_ERROR_INVALID_ARGUMENT;
   } else if (d.proxy_rule != DRAPE_PROXY_RULE_PAPER && d.proxy_rule != DRAPE_PROXY_RULE_DRAPE) {
     s << "context desc: proxy_rule = " << d.proxy_rule << " is not 0 (paper) or 1 (drape)";
     r = DRAPE_ERROR_OUT_OF_RANGE;
@@ -119,6 +123,7 @@ drape_result Context::pushFrame(const drape_skeleton_frame& f, std::string& err)
                   "skeleton frame: joint_count " + std::to_string(f.joint_count) + " does not match layout " +
                       std::to_string(f.layout) + " (" + std::to_string(expected) + " joints)");
   if (!f.joints) return reject(DRAPE_ERROR_NULL_ARGUMENT, "skeleton frame: joints is NULL");
+  if (f.reserved != 0) return reject(DRAPE_ERROR_INVALID_ARGUMENT, "skeleton frame: reserved must be 0");
   if (!std::isfinite(f.timestamp_s))
     return reject(DRAPE_ERROR_NONFINITE, "skeleton frame: timestamp_s is not finite");
   if (hasAccepted_ && !(f.timestamp_s > lastAcceptedTime_)) {

@@ -1,0 +1,327 @@
+#include "proxies/fidelity.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace drape {
+namespace {
+
+using Vec3d = Eigen::Vector3d;
+
+constexpr int kMaxBisections = 1100;  // > digits - min_exponent of double; never reached in practice
+constexpr float kInf = std::numeric_limits<float>::infinity();
+// A union sample is dropped when it lies deeper than this inside another ellipsoid, in that
+// ellipsoid's unit space (|q| < 1 - kStrictlyInside): about 0.1 mm for a 10 cm radius, so samples
+// on the seam where two surfaces cross are kept.
+constexpr float kStrictlyInside = 1e-3f;
+
+double robustLength(double a, double b) {
+  const double m = std::max(std::fabs(a), std::fabs(b));
+  if (m == 0.0) return 0.0;
+  const double x = a / m, y = b / m;
+  return m * std::sqrt(x * x + y * y);
+}
+
+double robustLength(double a, double b, double c) {
+  const double m = std::max(std::fabs(a), std::max(std::fabs(b), std::fabs(c)));
+  if (m == 0.0) return 0.0;
+  const double x = a / m, y = b / m, z = c / m;
+  return m * std::sqrt(x * x + y * y + z * z);
+}
+
+// Eberly: root of (r0 z0 / (s + r0))^2 + (z1 / (s + 1))^2 - 1 by bisection.
+double ellipseRoot(double r0, double z0, double z1, double g) {
+  const double n0 = r0 * z0;
+  double s0 = z1 - 1.0;
+  double s1 = g < 0.0 ? 0.0 : robustLength(n0, z1) - 1.0;
+  double s = 0.0;
+  for (int i = 0; i < kMaxBisections; ++i) {
+    s = 0.5 * (s0 + s1);
+    if (s == s0 || s == s1) break;
+    const double ratio0 = n0 / (s + r0), ratio1 = z1 / (s + 1.0);
+    g = ratio0 * ratio0 + ratio1 * ratio1 - 1.0;
+    if (g > 0.0) s0 = s;
+    else if (g < 0.0) s1 = s;
+    else break;
+  }
+  return s;
+}
+
+// Closest point on the ellipse (e0 >= e1 > 0) to (y0, y1), y >= 0, first quadrant.
+double distancePointEllipse(double e0, double e1, double y0, double y1, double& x0, double& x1) {
+  if (y1 > 0.0) {
+    if (y0 > 0.0) {
+      const double z0 = y0 / e0, z1 = y1 / e1;
+      const double g = z0 * z0 + z1 * z1 - 1.0;
+      if (g != 0.0) {
+        const double r0 = (e0 / e1) * (e0 / e1);
+        const double sbar = ellipseRoot(r0, z0, z1, g);
+        x0 = r0 * y0 / (sbar + r0);
+        x1 = y1 / (sbar + 1.0);
+        return std::sqrt((x0 - y0) * (x0 - y0) + (x1 - y1) * (x1 - y1));
+      }
+      x0 = y0;
+      x1 = y1;
+      return 0.0;
+    }
+    x0 = 0.0;
+    x1 = e1;
+    return std::fabs(y1 - e1);
+  }
+  const double numer0 = e0 * y0, denom0 = e0 * e0 - e1 * e1;
+  if (numer0 < denom0) {
+    const double xde0 = numer0 / denom0;
+    x0 = e0 * xde0;
+    x1 = e1 * std::sqrt(std::max(0.0, 1.0 - xde0 * xde0));
+    return std::sqrt((x0 - y0) * (x0 - y0) + x1 * x1);
+  }
+  x0 = e0;
+  x1 = 0.0;
+  return std::fabs(y0 - e0);
+}
+
+// Eberly: root of sum_i (r_i z_i / (s + r_i))^2 - 1 (r2 = 1) by bisection.
+double ellipsoidRoot(double r0, double r1, double z0, double z1, double z2, double g) {
+  const double n0 = r0 * z0, n1 = r1 * z1;
+  double s0 = z2 - 1.0;
+  double s1 = g < 0.0 ? 0.0 : robustLength(n0, n1, z2) - 1.0;
+  double s = 0.0;
+  for (int i = 0; i < kMaxBisections; ++i) {
+    s = 0.5 * (s0 + s1);
+    if (s == s0 || s == s1) break;
+    const double ratio0 = n0 / (s + r0), ratio1 = n1 / (s + r1), ratio2 = z2 / (s + 1.0);
+    g = ratio0 * ratio0 + ratio1 * ratio1 + ratio2 * ratio2 - 1.0;
+    if (g > 0.0) s0 = s;
+    else if (g < 0.0) s1 = s;
+    else break;
+  }
+  return s;
+}
+
+// Closest point on the ellipsoid (e0 >= e1 >= e2 > 0) to y >= 0, first octant.
+double distancePointEllipsoid(const double e[3], const double y[3], double x[3]) {
+  if (y[2] > 0.0) {
+    if (y[1] > 0.0) {
+      if (y[0] > 0.0) {
+        const double z0 = y[0] / e[0], z1 = y[1] / e[1], z2 = y[2] / e[2];
+        const double g = z0 * z0 + z1 * z1 + z2 * z2 - 1.0;
+        if (g != 0.0) {
+          const double r0 = (e[0] / e[2]) * (e[0] / e[2]), r1 = (e[1] / e[2]) * (e[1] / e[2]);
+          const double sbar = ellipsoidRoot(r0, r1, z0, z1, z2, g);
+          x[0] = r0 * y[0] / (sbar + r0);
+          x[1] = r1 * y[1] / (sbar + r1);
+          x[2] = y[2] / (sbar + 1.0);
+          return std::sqrt((x[0] - y[0]) * (x[0] - y[0]) + (x[1] - y[1]) * (x[1] - y[1]) +
+                           (x[2] - y[2]) * (x[2] - y[2]));
+        }
+        x[0] = y[0];
+        x[1] = y[1];
+        x[2] = y[2];
+        return 0.0;
+      }
+      x[0] = 0.0;
+      return distancePointEllipse(e[1], e[2], y[1], y[2], x[1], x[2]);
+    }
+    if (y[0] > 0.0) {
+      x[1] = 0.0;
+      return distancePointEllipse(e[0], e[2], y[0], y[2], x[0], x[2]);
+    }
+    x[0] = 0.0;
+    x[1] = 0.0;
+    x[2] = e[2];
+    return std::fabs(y[2] - e[2]);
+  }
+  // y2 == 0: an inside point may have its closest point off the plane.
+  const double denom0 = e[0] * e[0] - e[2] * e[2], denom1 = e[1] * e[1] - e[2] * e[2];
+  const double numer0 = e[0] * y[0], numer1 = e[1] * y[1];
+  if (numer0 < denom0 && numer1 < denom1) {
+    const double xde0 = numer0 / denom0, xde1 = numer1 / denom1;
+    const double discr = 1.0 - xde0 * xde0 - xde1 * xde1;
+    if (discr > 0.0) {
+      x[0] = e[0] * xde0;
+      x[1] = e[1] * xde1;
+      x[2] = e[2] * std::sqrt(discr);
+      return std::sqrt((x[0] - y[0]) * (x[0] - y[0]) + (x[1] - y[1]) * (x[1] - y[1]) + x[2] * x[2]);
+    }
+  }
+  x[2] = 0.0;
+  return distancePointEllipse(e[0], e[1], y[0], y[1], x[0], x[1]);
+}
+
+float boxDistance(const Vec3& p, const Vec3& lo, const Vec3& hi) {
+  const Vec3 d = (lo - p).cwiseMax(p - hi).cwiseMax(0.0f);
+  return d.norm();
+}
+
+bool inBox(const Vec3& p, const Vec3& lo, const Vec3& hi) {
+  return (p.array() >= lo.array()).all() && (p.array() <= hi.array()).all();
+}
+
+struct Stats {
+  float mean = 0.0f, p95 = 0.0f, max = 0.0f, weighted_mean = 0.0f;
+};
+
+// values in metres -> statistics in mm. Sorts `values` (scratch).
+Stats statistics(std::vector<float>& values, const std::vector<float>& weights) {
+  Stats s;
+  if (values.empty()) return s;
+  double sum = 0.0, wsum = 0.0, wtotal = 0.0;
+  for (size_t i = 0; i < values.size(); ++i) {
+    sum += values[i];
+    if (weights[i] > 0.0f) {
+      wsum += static_cast<double>(weights[i]) * values[i];
+      wtotal += weights[i];
+    }
+  }
+  s.mean = static_cast<float>(1000.0 * sum / static_cast<double>(values.size()));
+  s.weighted_mean = wtotal > 0.0 ? static_cast<float>(1000.0 * wsum / wtotal) : s.mean;
+  const size_t rank = static_cast<size_t>(std::ceil(0.95 * static_cast<double>(values.size())));
+  const size_t k = rank == 0 ? 0 : rank - 1;
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  s.p95 = 1000.0f * values[k];
+  s.max = 1000.0f * *std::max_element(values.begin(), values.end());
+  return s;
+}
+
+}  // namespace
+
+Vec3 fibonacciSpherePoint(int i, int n) {
+  if (n <= 0) return Vec3::UnitY();
+  const double golden = 3.14159265358979323846 * (3.0 - std::sqrt(5.0));
+  const double y = 1.0 - (2.0 * i + 1.0) / n;
+  const double r = std::sqrt(std::max(0.0, 1.0 - y * y));
+  const double phi = golden * i;
+  return Vec3(static_cast<float>(r * std::cos(phi)), static_cast<float>(y),
+              static_cast<float>(r * std::sin(phi)));
+}
+
+EllipsoidSurfacePoint ellipsoidSurfacePoint(const Ellipsoid& el, const Vec3& p) {
+  EllipsoidSurfacePoint out;
+  const Vec3d radii = el.radii.cast<double>();
+  const Vec3d d = p.cast<double>() - el.centre.cast<double>();
+  if (!(radii.minCoeff() > 0.0) || !std::isfinite(radii.sum()) || !std::isfinite(d.sum())) {
+    out.point = el.centre;
+    out.distance = static_cast<float>(d.norm());
+    return out;
+  }
+  const Eigen::Matrix3d rot = el.rotation.cast<double>();
+  const Vec3d local = rot.transpose() * d;
+  // Sort the axes by decreasing radius; solve in the first octant.
+  int order[3] = {0, 1, 2};
+  std::sort(order, order + 3, [&](int a, int b) { return radii[a] > radii[b]; });
+  double e[3], y[3], x[3];
+  for (int k = 0; k < 3; ++k) {
+    e[k] = radii[order[k]];
+    y[k] = std::fabs(local[order[k]]);
+  }
+  const double dist = distancePointEllipsoid(e, y, x);
+  Vec3d closest_local;
+  for (int k = 0; k < 3; ++k)
+    closest_local[order[k]] = local[order[k]] < 0.0 ? -x[k] : x[k];
+  out.point = (el.centre.cast<double>() + rot * closest_local).cast<float>();
+  out.distance = static_cast<float>(dist);
+  return out;
+}
+
+FidelityReport measureFidelity(const std::vector<Vec3>& body_positions,
+                               const std::vector<uint32_t>& body_indices,
+                               const Ellipsoid* ellipsoids, int count, const TriangleBvh& bvh,
+                               int samples_per_ellipsoid) {
+  FidelityReport report;
+  std::vector<Ellipsoid> ell;
+  if (ellipsoids && count > 0) {
+    ell.assign(ellipsoids, ellipsoids + count);
+    for (Ellipsoid& e : ell) e.refresh();  // bounds and to_unit from centre/rotation/radii
+  }
+  const size_t m = ell.size();
+
+  // ---- body -> union, per vertex ----
+  const size_t n = body_positions.size();
+  std::vector<float> vertex_area(n, 0.0f);
+  for (size_t t = 0; t + 2 < body_indices.size(); t += 3) {
+    const uint32_t a = body_indices[t], b = body_indices[t + 1], c = body_indices[t + 2];
+    if (a >= n || b >= n || c >= n) continue;
+    const float area = 0.5f * (body_positions[b] - body_positions[a])
+                                  .cross(body_positions[c] - body_positions[a]).norm();
+    if (!std::isfinite(area)) continue;
+    vertex_area[a] += area / 3.0f;
+    vertex_area[b] += area / 3.0f;
+    vertex_area[c] += area / 3.0f;
+  }
+  std::vector<float> outside(n, 0.0f);
+  std::vector<float> box_distance(m, 0.0f);
+  int outside_count = 0;
+  for (size_t v = 0; v < n; ++v) {
+    const Vec3& p = body_positions[v];
+    bool inside = false;
+    for (size_t j = 0; j < m && !inside; ++j)
+      inside = inBox(p, ell[j].bounds_min, ell[j].bounds_max) && ell[j].implicit(p) < 0.0f;
+    float best = kInf;
+    if (!inside) {
+      // Nearest box first, so the remaining boxes prune against a good bound.
+      size_t first = 0;
+      for (size_t j = 0; j < m; ++j) {
+        box_distance[j] = boxDistance(p, ell[j].bounds_min, ell[j].bounds_max);
+        if (box_distance[j] < box_distance[first]) first = j;
+      }
+      if (m > 0) best = ellipsoidSurfacePoint(ell[first], p).distance;
+      for (size_t j = 0; j < m; ++j) {
+        if (j == first || !(box_distance[j] < best)) continue;
+        best = std::min(best, ellipsoidSurfacePoint(ell[j], p).distance);
+      }
+    } else {
+      best = 0.0f;
+    }
+    outside[v] = best;
+    if (!(best <= kFidelityOutsideMm * 1e-3f)) ++outside_count;
+  }
+  if (n > 0) {
+    const Stats s = statistics(outside, vertex_area);
+    report.body_to_union_mean_mm = s.mean;
+    report.body_to_union_p95_mm = s.p95;
+    report.body_to_union_max_mm = s.max;
+    report.body_to_union_area_mean_mm = s.weighted_mean;
+    report.outside_fraction = static_cast<float>(outside_count) / static_cast<float>(n);
+    report.body_vertices = static_cast<int>(n);
+  }
+
+  // ---- union -> body, Fibonacci samples on each ellipsoid's exposed surface ----
+  const int per = std::max(0, samples_per_ellipsoid);
+  std::vector<float> dist, weight;
+  dist.reserve(m * static_cast<size_t>(per));
+  weight.reserve(m * static_cast<size_t>(per));
+  const float solid_angle = per > 0 ? 4.0f * kPi / static_cast<float>(per) : 0.0f;
+  for (size_t i = 0; i < m; ++i) {
+    const Ellipsoid& e = ell[i];
+    const float volume_factor = e.radii.prod();
+    for (int k = 0; k < per; ++k) {
+      const Vec3 u = fibonacciSpherePoint(k, per);
+      const Vec3 x = e.fromUnit(u);
+      bool covered = false;
+      for (size_t j = 0; j < m && !covered; ++j) {
+        if (j == i || !inBox(x, ell[j].bounds_min, ell[j].bounds_max)) continue;
+        covered = ell[j].toUnit(x).norm() < 1.0f - kStrictlyInside;
+      }
+      if (covered) continue;
+      const TriangleBvh::Hit h = bvh.closest(x);
+      // Only where the union sticks out of the body: a union surface point inside the body is a
+      // gap of the proxies, which the body -> union direction already measures (and points deep
+      // inside are internal pockets of the union that no cloth can reach).
+      dist.push_back(TriangleBvh::hitSign(x, h) > 0.0f ? h.distance : 0.0f);
+      // Area element of the unit sphere -> ellipsoid map at u: det(S) |S^-1 u| dOmega.
+      weight.push_back(volume_factor * u.cwiseQuotient(e.radii).norm() * solid_angle);
+    }
+  }
+  report.union_samples = static_cast<int>(dist.size());
+  if (!dist.empty()) {
+    const Stats s = statistics(dist, weight);
+    report.union_to_body_mean_mm = s.mean;
+    report.union_to_body_p95_mm = s.p95;
+    report.union_to_body_max_mm = s.max;
+    report.union_to_body_area_mean_mm = s.weighted_mean;
+  }
+  return report;
+}
+
+}  // namespace drape

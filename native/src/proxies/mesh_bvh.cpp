@@ -1,0 +1,356 @@
+#include "proxies/mesh_bvh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace drape {
+namespace {
+
+// Closest point on segment [a, b] to p, and its squared distance.
+Vec3 closestOnSegment(const Vec3& p, const Vec3& a, const Vec3& b, float& d2) {
+  const Vec3 ab = b - a;
+  const float len2 = ab.squaredNorm();
+  float t = len2 > 0.0f ? (p - a).dot(ab) / len2 : 0.0f;
+  t = std::min(1.0f, std::max(0.0f, t));
+  const Vec3 q = a + t * ab;
+  d2 = (p - q).squaredNorm();
+  return q;
+}
+
+inline float boxDistance2(const Vec3& p, const Vec3& lo, const Vec3& hi) {
+  float d2 = 0.0f;
+  for (int i = 0; i < 3; ++i) {
+    const float below = lo[i] - p[i];
+    const float above = p[i] - hi[i];
+    const float d = std::max(0.0f, std::max(below, above));
+    d2 += d * d;
+  }
+  return d2;
+}
+
+}  // namespace
+
+Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
+                            TriangleFeature* feature) {
+  TriangleFeature f = TriangleFeature::Face;
+  Vec3 result;
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const float d1 = ab.dot(ap), d2 = ac.dot(ap);
+  const Vec3 bp = p - b;
+  const float d3 = ab.dot(bp), d4 = ac.dot(bp);
+  const Vec3 cp = p - c;
+  const float d5 = ab.dot(cp), d6 = ac.dot(cp);
+  const float vc = d1 * d4 - d3 * d2;
+  const float vb = d5 * d2 - d1 * d6;
+  const float va = d3 * d6 - d5 * d4;
+  if (d1 <= 0.0f && d2 <= 0.0f) {
+    f = TriangleFeature::VertexA;
+    result = a;
+  } else if (d3 >= 0.0f && d4 <= d3) {
+    f = TriangleFeature::VertexB;
+    result = b;
+  } else if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) {
+    f = TriangleFeature::EdgeAB;
+    const float den = d1 - d3;  // = |ab|^2
+    result = den > 0.0f ? Vec3(a + (d1 / den) * ab) : a;
+  } else if (d6 >= 0.0f && d5 <= d6) {
+    f = TriangleFeature::VertexC;
+    result = c;
+  } else if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) {
+    f = TriangleFeature::EdgeCA;
+    const float den = d2 - d6;  // = |ac|^2
+    result = den > 0.0f ? Vec3(a + (d2 / den) * ac) : a;
+  } else if (va <= 0.0f && (d4 - d3) >= 0.0f && (d5 - d6) >= 0.0f) {
+    f = TriangleFeature::EdgeBC;
+    const float den = (d4 - d3) + (d5 - d6);  // = |bc|^2
+    result = den > 0.0f ? Vec3(b + ((d4 - d3) / den) * (c - b)) : b;
+  } else {
+    const float sum = va + vb + vc;  // = |ab x ac|^2 up to rounding
+    if (sum > 0.0f) {
+      const float inv = 1.0f / sum;
+      result = a + ab * (vb * inv) + ac * (vc * inv);
+    } else {
+      // Degenerate (collinear) triangle that fell through every region test: nearest of the
+      // three sides.
+      float e0 = 0.0f, e1 = 0.0f, e2 = 0.0f;
+      const Vec3 q0 = closestOnSegment(p, a, b, e0);
+      const Vec3 q1 = closestOnSegment(p, b, c, e1);
+      const Vec3 q2 = closestOnSegment(p, c, a, e2);
+      if (e0 <= e1 && e0 <= e2) {
+        result = q0;
+        f = TriangleFeature::EdgeAB;
+      } else if (e1 <= e2) {
+        result = q1;
+        f = TriangleFeature::EdgeBC;
+      } else {
+        result = q2;
+        f = TriangleFeature::EdgeCA;
+      }
+    }
+  }
+  if (feature) *feature = f;
+  return result;
+}
+
+void TriangleBvh::clear() {
+  nodes_.clear();
+  tris_.clear();
+  corners_.clear();
+  face_normals_.clear();
+  edge_normals_.clear();
+  vertex_normals_.clear();
+  indices_.clear();
+  vertex_count_ = 0;
+  depth_ = 0;
+}
+
+bool TriangleBvh::build(const std::vector<Vec3>& positions, const std::vector<uint32_t>& indices,
+                        bool allow_refit) {
+  if (allow_refit && !nodes_.empty() && positions.size() == vertex_count_ && indices == indices_)
+    return refit(positions);
+
+  clear();
+  const size_t tri_count = indices.size() / 3;
+  if (indices.size() % 3 != 0 || tri_count == 0 || tri_count > (size_t{1} << 31)) return false;
+  for (const uint32_t i : indices)
+    if (i >= positions.size()) return false;
+  for (const Vec3& v : positions)
+    if (!isFinite(v)) return false;
+
+  indices_ = indices;
+  vertex_count_ = positions.size();
+
+  // Edge ids: sort (undirected key, corner) pairs so equal edges are adjacent.
+  std::vector<std::pair<uint64_t, uint32_t>> edges(indices.size());
+  for (size_t t = 0; t < tri_count; ++t) {
+    for (size_t k = 0; k < 3; ++k) {
+      const uint32_t u = indices[3 * t + k], w = indices[3 * t + (k + 1) % 3];
+      const uint64_t key = (static_cast<uint64_t>(std::min(u, w)) << 32) | std::max(u, w);
+      edges[3 * t + k] = {key, static_cast<uint32_t>(3 * t + k)};
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  std::vector<uint32_t> corner_edge(indices.size());
+  uint32_t edge_count = 0;
+  for (size_t i = 0; i < edges.size(); ++i) {
+    if (i > 0 && edges[i].first != edges[i - 1].first) ++edge_count;
+    corner_edge[edges[i].second] = edge_count;
+  }
+  ++edge_count;
+
+  // Top-down median split over an index permutation.
+  std::vector<Vec3> centroids(tri_count);
+  for (size_t t = 0; t < tri_count; ++t)
+    centroids[t] = (positions[indices[3 * t]] + positions[indices[3 * t + 1]] +
+                    positions[indices[3 * t + 2]]) / 3.0f;
+  tris_.resize(tri_count);
+  for (size_t t = 0; t < tri_count; ++t) tris_[t].id = static_cast<uint32_t>(t);
+  nodes_.reserve(2 * (tri_count / kLeafSize + 1));
+  buildNode(0, static_cast<uint32_t>(tri_count), centroids, 1);
+  if (depth_ > kStackSize - 2) {  // unreachable for a median split below 2^31 triangles
+    clear();
+    return false;
+  }
+  for (Tri& tri : tris_) {
+    for (uint32_t k = 0; k < 3; ++k) {
+      tri.v[k] = indices[3 * size_t{tri.id} + k];
+      tri.e[k] = corner_edge[3 * size_t{tri.id} + k];
+    }
+  }
+
+  corners_.resize(3 * tri_count);
+  face_normals_.resize(tri_count);
+  edge_normals_.resize(edge_count);
+  vertex_normals_.resize(positions.size());
+  updateGeometry(positions);
+  refitBoxes();
+  return true;
+}
+
+uint32_t TriangleBvh::buildNode(uint32_t begin, uint32_t end, std::vector<Vec3>& centroids,
+                                int level) {
+  const uint32_t index = static_cast<uint32_t>(nodes_.size());
+  nodes_.push_back(Node{});
+  depth_ = std::max(depth_, level);
+  if (end - begin <= static_cast<uint32_t>(kLeafSize)) {
+    nodes_[index].first = begin;
+    nodes_[index].count = end - begin;
+    return index;
+  }
+  Vec3 lo = centroids[tris_[begin].id], hi = lo;
+  for (uint32_t s = begin + 1; s < end; ++s) {
+    lo = lo.cwiseMin(centroids[tris_[s].id]);
+    hi = hi.cwiseMax(centroids[tris_[s].id]);
+  }
+  int axis = 0;
+  const Vec3 extent = hi - lo;
+  if (extent[1] > extent[axis]) axis = 1;
+  if (extent[2] > extent[axis]) axis = 2;
+  const uint32_t mid = begin + (end - begin) / 2;
+  std::nth_element(tris_.begin() + begin, tris_.begin() + mid, tris_.begin() + end,
+                   [&](const Tri& x, const Tri& y) {
+                     return centroids[x.id][axis] < centroids[y.id][axis];
+                   });
+  // Recursion depth is the tree depth, which the median split bounds by log2(n) + 1.
+  buildNode(begin, mid, centroids, level + 1);
+  const uint32_t right = buildNode(mid, end, centroids, level + 1);
+  nodes_[index].first = right;
+  nodes_[index].count = 0;
+  return index;
+}
+
+bool TriangleBvh::refit(const std::vector<Vec3>& positions) {
+  if (nodes_.empty() || positions.size() != vertex_count_) return false;
+  updateGeometry(positions);
+  refitBoxes();
+  return true;
+}
+
+void TriangleBvh::updateGeometry(const std::vector<Vec3>& positions) {
+  for (Vec3& n : edge_normals_) n.setZero();
+  for (Vec3& n : vertex_normals_) n.setZero();
+  for (size_t s = 0; s < tris_.size(); ++s) {
+    const Tri& tri = tris_[s];
+    const Vec3 a = positions[tri.v[0]], b = positions[tri.v[1]], c = positions[tri.v[2]];
+    corners_[3 * s] = a;
+    corners_[3 * s + 1] = b;
+    corners_[3 * s + 2] = c;
+    const Vec3 cr = (b - a).cross(c - a);
+    const float len = cr.norm();
+    if (!(len > 0.0f)) {
+      face_normals_[s].setZero();
+      continue;
+    }
+    const Vec3 n = cr / len;
+    face_normals_[s] = n;
+    for (int k = 0; k < 3; ++k) edge_normals_[tri.e[k]] += n;
+    // Interior angles (|cross| is the same for all three corners); the third from the sum.
+    const float angle_a = std::atan2(len, (b - a).dot(c - a));
+    const float angle_b = std::atan2(len, (c - b).dot(a - b));
+    const float angle_c = std::max(0.0f, kPi - angle_a - angle_b);
+    vertex_normals_[tri.v[0]] += angle_a * n;
+    vertex_normals_[tri.v[1]] += angle_b * n;
+    vertex_normals_[tri.v[2]] += angle_c * n;
+  }
+  auto normalise = [](std::vector<Vec3>& v) {
+    for (Vec3& n : v) {
+      const float len = n.norm();
+      if (len > 0.0f) n /= len;
+      else n.setZero();
+    }
+  };
+  normalise(edge_normals_);
+  normalise(vertex_normals_);
+}
+
+void TriangleBvh::refitBoxes() {
+  // Depth-first storage: both children of node i have larger indices, so a backward sweep sees
+  // children before parents.
+  for (size_t i = nodes_.size(); i-- > 0;) {
+    Node& n = nodes_[i];
+    if (n.count > 0) {
+      Vec3 lo = corners_[3 * n.first], hi = lo;
+      for (uint32_t k = 3 * n.first + 1; k < 3 * (n.first + n.count); ++k) {
+        lo = lo.cwiseMin(corners_[k]);
+        hi = hi.cwiseMax(corners_[k]);
+      }
+      n.lo = lo;
+      n.hi = hi;
+    } else {
+      const Node& l = nodes_[i + 1];
+      const Node& r = nodes_[n.first];
+      n.lo = l.lo.cwiseMin(r.lo);
+      n.hi = l.hi.cwiseMax(r.hi);
+    }
+  }
+}
+
+void TriangleBvh::testTriangle(uint32_t slot, const Vec3& p, float& best2, Hit& hit) const {
+  TriangleFeature f;
+  const Vec3 q = closestPointOnTriangle(p, corners_[3 * slot], corners_[3 * slot + 1],
+                                        corners_[3 * slot + 2], &f);
+  const float d2 = (p - q).squaredNorm();
+  if (d2 < best2) {
+    best2 = d2;
+    hit.point = q;
+    hit.triangle = static_cast<int>(slot);  // slot for now; finishHit maps it to the id
+    hit.feature = f;
+  }
+}
+
+void TriangleBvh::finishHit(const Vec3& p, Hit& hit) const {
+  if (hit.triangle < 0) {
+    hit.point = p;
+    return;
+  }
+  const size_t slot = static_cast<size_t>(hit.triangle);
+  const Tri& tri = tris_[slot];
+  hit.triangle = static_cast<int>(tri.id);
+  hit.distance = (p - hit.point).norm();
+  hit.normal = face_normals_[slot];
+  switch (hit.feature) {
+    case TriangleFeature::Face: hit.pseudo_normal = face_normals_[slot]; break;
+    case TriangleFeature::EdgeAB: hit.pseudo_normal = edge_normals_[tri.e[0]]; break;
+    case TriangleFeature::EdgeBC: hit.pseudo_normal = edge_normals_[tri.e[1]]; break;
+    case TriangleFeature::EdgeCA: hit.pseudo_normal = edge_normals_[tri.e[2]]; break;
+    case TriangleFeature::VertexA: hit.pseudo_normal = vertex_normals_[tri.v[0]]; break;
+    case TriangleFeature::VertexB: hit.pseudo_normal = vertex_normals_[tri.v[1]]; break;
+    case TriangleFeature::VertexC: hit.pseudo_normal = vertex_normals_[tri.v[2]]; break;
+  }
+}
+
+TriangleBvh::Hit TriangleBvh::closest(const Vec3& p, float max_distance) const {
+  Hit hit;
+  if (nodes_.empty() || !(max_distance > 0.0f)) {
+    hit.point = p;
+    return hit;
+  }
+  float best2 = max_distance * max_distance;
+  struct Entry {
+    uint32_t node;
+    float d2;
+  };
+  Entry stack[kStackSize];
+  int sp = 0;
+  stack[sp++] = {0, boxDistance2(p, nodes_[0].lo, nodes_[0].hi)};
+  while (sp > 0) {
+    const Entry e = stack[--sp];
+    if (e.d2 >= best2) continue;
+    const Node& n = nodes_[e.node];
+    if (n.count > 0) {
+      for (uint32_t s = n.first; s < n.first + n.count; ++s) testTriangle(s, p, best2, hit);
+      continue;
+    }
+    const uint32_t left = e.node + 1, right = n.first;
+    const float dl = boxDistance2(p, nodes_[left].lo, nodes_[left].hi);
+    const float dr = boxDistance2(p, nodes_[right].lo, nodes_[right].hi);
+    // Push the farther child first so the nearer one is searched first and tightens best2.
+    // The stack never holds more than depth + 1 entries (checked at build).
+    if (dl <= dr) {
+      if (dr < best2) stack[sp++] = {right, dr};
+      if (dl < best2) stack[sp++] = {left, dl};
+    } else {
+      if (dl < best2) stack[sp++] = {left, dl};
+      if (dr < best2) stack[sp++] = {right, dr};
+    }
+  }
+  finishHit(p, hit);
+  return hit;
+}
+
+TriangleBvh::Hit TriangleBvh::closestBruteForce(const Vec3& p) const {
+  Hit hit;
+  float best2 = std::numeric_limits<float>::infinity();
+  for (uint32_t s = 0; s < tris_.size(); ++s) testTriangle(s, p, best2, hit);
+  finishHit(p, hit);
+  return hit;
+}
+
+float TriangleBvh::signedDistance(const Vec3& p) const {
+  const Hit h = closest(p);
+  if (h.triangle < 0) return std::numeric_limits<float>::infinity();
+  return hitSign(p, h) * h.distance;
+}
+
+}  // namespace drape
