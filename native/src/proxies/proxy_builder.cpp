@@ -172,6 +172,30 @@ void ProxyBuilder::build(const BodyModel& body, const SkeletonPose& pose) {
       add(e, {chain, scratchRing_[static_cast<size_t>(i)], -1});
     }
   }
+  if (!paper) {
+    // Caps: head, fingertips and toes end in a fan to an apex vertex beyond the last ring; one
+    // slim ellipsoid from that ring to the apex covers it (section 0.45 of the ring, so it does
+    // not bulge out of the cone by more than a few percent of the ring radius).
+    const Chain ends[5] = {Chain::Head, Chain::ArmL, Chain::ArmR, Chain::LegL, Chain::LegR};
+    const auto& positions = body.positions();
+    for (int a = 0; a < 5; ++a) {
+      const int last = body.chainFirstRing(ends[a]) + body.chainRingCount(ends[a]) - 1;
+      const RingPose& r = rings[last];
+      const Vec3& apex = positions[positions.size() - 5 + static_cast<size_t>(a)];
+      const Vec3 span = apex - r.centre;
+      const float len = span.norm();
+      Ellipsoid e;
+      e.centre = r.centre + 0.5f * span;
+      e.rotation = r.frame;
+      if (len > 1e-6f) {
+        const Quat q = Quat::FromTwoVectors(r.frame.col(1), span / len);
+        e.rotation = (q.toRotationMatrix() * r.frame).eval();
+      }
+      e.radii = Vec3(std::max(0.45f * r.forward_m, 1e-3f), std::max(0.52f * len, 1e-3f),
+                     std::max(0.45f * r.side_m, 1e-3f));
+      add(e, {ends[a], last, -1});
+    }
+  }
   // ellipsoids_ never shrinks (no allocation per frame); the live count is count_.
   ellipsoids_.resize(count_);
   sources_.resize(count_);
