@@ -59,7 +59,9 @@ foreach(path "drape_version" "recording" "format" "layout" "frames" "rejected_fr
              "stages_ms|skeleton" "stages_ms|body" "body|vertices" "body|triangles"
              "body|watertight_frames" "body|volume_l" "shape|height_m" "shape|weight_kg"
              "shape|neck_mm" "shape|chest_mm" "shape|waist_mm" "shape|hip_mm" "shape|thigh_mm"
-             "shape|calf_mm" "shape|upper_arm_mm" "shape|forearm_mm" "ring_points")
+             "shape|calf_mm" "shape|upper_arm_mm" "shape|forearm_mm" "ring_points"
+             "stages_ms|proxies" "proxies|count" "proxies|rule" "proxies|frames_measured"
+             "proxies|fit_p95_mm" "proxies|fit_max_mm" "proxies|outside_fraction")
   string(REPLACE "|" ";" _keys "${path}")
   json_get(_unused ${_keys})
 endforeach()
@@ -84,6 +86,17 @@ if(DEFINED VOLUME_MIN_L)
   if(NOT _volume MATCHES "^[0-9.eE+-]+$" OR _volume LESS VOLUME_MIN_L OR _volume GREATER VOLUME_MAX_L)
     string(APPEND _failures "  body.volume_l = ${_volume}, expected within [${VOLUME_MIN_L}, ${VOLUME_MAX_L}]\n")
   endif()
+endif()
+
+# Tracking ellipsoids: present, measured, and within the fidelity target (P95 <= 10 mm).
+json_get(_proxy_count proxies count)
+json_get(_fit_p95 proxies fit_p95_mm)
+json_get(_measured proxies frames_measured)
+if(NOT _proxy_count GREATER 0)
+  string(APPEND _failures "  proxies.count = ${_proxy_count}, expected > 0\n")
+endif()
+if(_measured GREATER 0 AND (NOT _fit_p95 MATCHES "^[0-9.eE+-]+$" OR _fit_p95 GREATER 10))
+  string(APPEND _failures "  proxies.fit_p95_mm = ${_fit_p95}, expected <= 10\n")
 endif()
 
 file(GLOB _objs "${OUT_DIR}/body_*.obj")

@@ -135,6 +135,7 @@ int run(int argc, char** argv) {
   drape_context_desc desc;
   drape_context_desc_init(&desc);
   if (opt.ring_points != 0) desc.ring_points = opt.ring_points;
+  desc.proxy_rule = opt.proxy_rule;
   drape_context* raw_ctx = nullptr;
   if (drape_result r = drape_context_create(&desc, &raw_ctx)) {
     if (isFatalLibraryError(r)) return fail(kExitFailure, "drape_context_create failed: " + libraryReason(r));
@@ -158,6 +159,9 @@ int run(int argc, char** argv) {
   st.recording_frames = info.frame_count;
   st.recording_rate_hz = info.nominal_rate_hz;
   st.ring_points = desc.ring_points;
+  st.proxy_rule = desc.proxy_rule;
+  if (drape_result r = drape_context_get_ellipsoid_count(ctx.get(), &st.proxy_count))
+    return fail(kExitFailure, "drape_context_get_ellipsoid_count failed: " + libraryReason(r));
   drape_body_shape_init(&st.shape);
   if (drape_result r = drape_context_get_body_shape(ctx.get(), &st.shape))
     return fail(kExitFailure, "drape_context_get_body_shape failed: " + libraryReason(r));
@@ -225,6 +229,19 @@ int run(int argc, char** argv) {
                     static_cast<uint64_t>(!std::isfinite(fs_stats.body_volume_l));
     st.skeleton_ms.push_back(fs_stats.skeleton_ms);
     st.body_ms.push_back(fs_stats.body_ms);
+    st.proxies_ms.push_back(fs_stats.proxies_ms);
+    st.nonfinite += static_cast<uint64_t>(!std::isfinite(fs_stats.proxies_ms));
+
+    if (opt.fidelity_every != 0 && (st.ms_per_frame.size() - 1) % opt.fidelity_every == 0) {
+      drape_proxy_fidelity fid{};
+      fid.struct_size = sizeof fid;
+      if (drape_result r = drape_context_measure_proxy_fidelity(ctx.get(), &fid))
+        return fail(kExitFailure, "drape_context_measure_proxy_fidelity failed: " + libraryReason(r));
+      st.body_to_proxy_p95.push_back(fid.body_to_proxy_p95_mm);
+      st.proxy_to_body_p95.push_back(fid.proxy_to_body_p95_mm);
+      st.fit_max.push_back(std::max(fid.body_to_proxy_max_mm, fid.proxy_to_body_max_mm));
+      st.outside_fraction.push_back(fid.outside_fraction);
+    }
 
     if (drape_result r = drape_context_read_body_mesh(ctx.get(), positions.data(), normals.data(), vertex_count,
                                                       indices.data(), index_count))

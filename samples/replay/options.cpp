@@ -171,6 +171,22 @@ bool parseOptions(int argc, const char* const* argv, Options& o, std::string& er
         error = "--ring-points '" + value + "' is not a whole number (a multiple of 4 in [8, 256], e.g. 20)";
         return false;
       }
+    } else if (name == "--proxy-rule") {
+      if (!takeValue()) return false;
+      if (value == "paper") {
+        o.proxy_rule = DRAPE_PROXY_RULE_PAPER;
+      } else if (value == "drape") {
+        o.proxy_rule = DRAPE_PROXY_RULE_DRAPE;
+      } else {
+        error = "--proxy-rule '" + value + "' is not 'paper' or 'drape'";
+        return false;
+      }
+    } else if (name == "--fidelity-every") {
+      if (!takeValue()) return false;
+      if (!parseUint(value, 0, 0xffffffffUL, o.fidelity_every)) {
+        error = "--fidelity-every '" + value + "' is not a whole number >= 0 (0 turns the measurement off)";
+        return false;
+      }
     } else if (name == "--out") {
       if (!takeValue()) return false;
       if (value.empty()) {
@@ -220,6 +236,9 @@ std::string helpText() {
       "                        upper_arm_mm, forearm_mm (girths left out are predicted)\n"
       "  --frames N            replay at most N frames (N >= 1; default: all)\n"
       "  --ring-points K       points per feature ring: multiple of 4 in [8, 256] (default 20)\n"
+      "  --proxy-rule R        tracking ellipsoids: drape (default) or paper (the paper's eq. 5-6)\n"
+      "  --fidelity-every N    measure how closely the ellipsoids fit the body every N frames\n"
+      "                        (default 10; 0 = never; about 10 ms per measurement)\n"
       "  --out DIR             output directory for body_NNNNN.obj and stats.json (default ./drape-out;\n"
       "                        created if missing)\n"
       "  --no-obj              do not write OBJ files (for timing)\n"

@@ -15,6 +15,8 @@ struct Options {
   bool body_given = false;
   uint32_t max_frames = 0;         // 0: every frame of the recording
   uint32_t ring_points = 0;        // 0: the library default
+  int32_t proxy_rule = DRAPE_PROXY_RULE_DRAPE;
+  uint32_t fidelity_every = 10;    // measure proxy fidelity every N updated frames; 0: never
   std::string out_dir = "drape-out";
   bool out_given = false;
   bool write_obj = true;

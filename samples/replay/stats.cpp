@@ -101,6 +101,7 @@ std::string statsJson(const ReplayStats& s) {
   w.key("stages_ms").beginObject();
   w.key("skeleton").value(median(s.skeleton_ms));
   w.key("body").value(median(s.body_ms));
+  w.key("proxies").value(median(s.proxies_ms));
   w.endObject();
 
   w.key("body").beginObject();
@@ -108,6 +109,23 @@ std::string statsJson(const ReplayStats& s) {
   w.key("triangles").value(s.triangles);
   w.key("watertight_frames").value(s.watertight_frames);
   w.key("volume_l").value(median(s.volume_l));
+  w.endObject();
+
+  // fit_p95_mm: per measured frame the larger of the two directions' P95 (body sticking out of
+  // the ellipsoids, ellipsoids sticking out of the body), median over frames; fit_max_mm: the
+  // largest single distance seen on any measured frame.
+  std::vector<double> fit_p95;
+  for (size_t i = 0; i < s.body_to_proxy_p95.size(); ++i)
+    fit_p95.push_back(std::max(s.body_to_proxy_p95[i], s.proxy_to_body_p95[i]));
+  w.key("proxies").beginObject();
+  w.key("count").value(s.proxy_count);
+  w.key("rule").value(s.proxy_rule == DRAPE_PROXY_RULE_PAPER ? "paper" : "drape");
+  w.key("frames_measured").value(static_cast<uint32_t>(fit_p95.size()));
+  w.key("fit_p95_mm").value(median(fit_p95));
+  w.key("fit_max_mm").value(maximum(s.fit_max));
+  w.key("body_to_proxy_p95_mm").value(median(s.body_to_proxy_p95));
+  w.key("proxy_to_body_p95_mm").value(median(s.proxy_to_body_p95));
+  w.key("outside_fraction").value(median(s.outside_fraction));
   w.endObject();
 
   w.key("shape").beginObject();
@@ -140,12 +158,18 @@ std::string summaryText(const ReplayStats& s, const std::string& obj_dir, const 
       s.triangles, s.ring_points, s.watertight_frames, s.frames - s.rejected_frames);
   appendf(o, "volume      %.2f L median (shape %.2f m, %.1f kg)\n", median(s.volume_l),
       static_cast<double>(s.shape.height_m), static_cast<double>(s.shape.weight_kg));
+  if (!s.body_to_proxy_p95.empty())
+    appendf(o, "proxies     %u ellipsoids (%s rule); fit P95 body->proxy %.1f mm, proxy->body %.1f mm (median of %zu frames)\n",
+        s.proxy_count, s.proxy_rule == DRAPE_PROXY_RULE_PAPER ? "paper" : "drape", median(s.body_to_proxy_p95),
+        median(s.proxy_to_body_p95), s.body_to_proxy_p95.size());
   o += "\n";
   appendf(o, "%-16s %10s %10s %10s %12s\n", "stage", "median ms", "p90 ms", "max ms", "paper ms");
   appendf(o, "%-16s %10s %10s %10s %12s\n", "skeleton", fmtMs(median(s.skeleton_ms)).c_str(),
       fmtMs(percentile(s.skeleton_ms, 90)).c_str(), fmtMs(maximum(s.skeleton_ms)).c_str(), "-");
   appendf(o, "%-16s %10s %10s %10s %12s\n", "body", fmtMs(median(s.body_ms)).c_str(),
       fmtMs(percentile(s.body_ms, 90)).c_str(), fmtMs(maximum(s.body_ms)).c_str(), fmtMs(kPaperBodyMs).c_str());
+  appendf(o, "%-16s %10s %10s %10s %12s\n", "proxies", fmtMs(median(s.proxies_ms)).c_str(),
+      fmtMs(percentile(s.proxies_ms, 90)).c_str(), fmtMs(maximum(s.proxies_ms)).c_str(), "~0");
   appendf(o, "%-16s %10s %10s %10s %12s\n", "push+update", fmtMs(median(s.ms_per_frame)).c_str(),
       fmtMs(percentile(s.ms_per_frame, 90)).c_str(), fmtMs(maximum(s.ms_per_frame)).c_str(), "-");
   o += "\n";

@@ -33,6 +33,12 @@ struct ReplayStats {
   std::vector<double> skeleton_ms;
   std::vector<double> body_ms;
   std::vector<double> volume_l;
+  std::vector<double> proxies_ms;
+
+  // Tracking ellipsoids: count, rule, and fidelity on the measured frames (mm).
+  uint32_t proxy_count = 0;
+  int32_t proxy_rule = DRAPE_PROXY_RULE_DRAPE;
+  std::vector<double> body_to_proxy_p95, proxy_to_body_p95, fit_max, outside_fraction;
 };
 
 // Median (mean of the two middle values for an even count) and nearest-rank percentile
