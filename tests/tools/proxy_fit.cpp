@@ -1,6 +1,6 @@
 // drape-proxy-fit: how closely the tracking ellipsoids follow the body mesh on recordings, for
 // both construction rules side by side (the figures in docs/proxies.md).
-// Usage: drape-proxy-fit RECORDING... (every 3rd frame measured, 256 samples per ellipsoid)
+// Usage: drape-proxy-fit RECORDING... (every frame measured, 256 samples per ellipsoid)
 #include "body/body_model.h"
 #include "proxies/fidelity.h"
 #include "proxies/proxy_builder.h"
@@ -54,7 +54,6 @@ int main(int argc, char** argv) {
         tracker.push(raw, rec.frames[i].time_s);
         body.update(tracker.pose());
         proxies.build(body, tracker.pose());
-        if (i % 3 != 0) continue;
         bvh.refit(body.positions());
         const auto& e = proxies.ellipsoids();
         const FidelityReport f = measureFidelity(body.positions(), body.indices(), e.data(), static_cast<int>(e.size()), bvh);
