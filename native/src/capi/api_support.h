@@ -42,7 +42,11 @@ inline bool finite(double v) { return std::isfinite(v); }
 // Runs `body` (returning drape_result), mapping exceptions to result codes.
 template <typename F>
 drape_result guarded(const char* function, F&& body) noexcept {
-  setCurrentFunction(function);
+  // Names the entry point for fail() while it runs, and only then.
+  struct Scope {
+    explicit Scope(const char* f) { setCurrentFunction(f); }
+    ~Scope() { setCurrentFunction(nullptr); }
+  } scope(function);
   try {
     return body();
   } catch (const std::bad_alloc&) {

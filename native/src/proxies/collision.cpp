@@ -1,0 +1,520 @@
+#include "proxies/collision.h"
+
+#include "proxies/closest_point.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#if defined(_MSC_VER)
+#include <intrin.h>
+#endif
+
+namespace drape {
+namespace {
+
+inline int lowestBit(uint64_t m) {
+#if defined(_MSC_VER)
+  unsigned long index = 0;
+  _BitScanForward64(&index, m);
+  return static_cast<int>(index);
+#else
+  return __builtin_ctzll(m);
+#endif
+}
+
+// 3x3 times 3-vector written out: GCC does not always inline Eigen's small products.
+inline Vec3 mulv(const Mat3& m, const Vec3& v) {
+  return m.col(0) * v.x() + m.col(1) * v.y() + m.col(2) * v.z();
+}
+inline Vec3 mulvT(const Mat3& m, const Vec3& v) {  // m^T v
+  return Vec3(m.col(0).dot(v), m.col(1).dot(v), m.col(2).dot(v));
+}
+
+// Box tests with & rather than &&: no branch per comparison (random particle data mispredicts).
+inline bool containsPoint(const Vec3& mn, const Vec3& mx, const Vec3& p) {
+  return (p.x() >= mn.x()) & (p.x() <= mx.x()) & (p.y() >= mn.y()) & (p.y() <= mx.y()) &
+         (p.z() >= mn.z()) & (p.z() <= mx.z());
+}
+
+inline bool overlaps(const Vec3& lo, const Vec3& hi, const Vec3& mn, const Vec3& mx) {
+  return (lo.x() <= mx.x()) & (hi.x() >= mn.x()) & (lo.y() <= mx.y()) & (hi.y() >= mn.y()) &
+         (lo.z() <= mx.z()) & (hi.z() >= mn.z());
+}
+
+// Cell coordinates of a point (4-wide: the w lane is ignored), clamped to the grid. Monotone in
+// each coordinate, so a point inside two boxes lies in a cell both boxes' cell ranges include.
+inline Eigen::Array4i cellsOf(const Vec3& p, const Eigen::Array4f& origin, const Eigen::Array4f& scale,
+                              const Eigen::Array4f& top) {
+  const Eigen::Array4f v(p.x(), p.y(), p.z(), 0.0f);
+  return ((v - origin) * scale).max(Eigen::Array4f::Zero()).min(top).cast<int>();
+}
+
+// Positional Coulomb friction against the moving surface (Macklin et al. 2014, §6.1). qc is the
+// contact's unit-space coordinate; the surface point under the particle moved from E_start(qc)
+// to E_end(qc) during the substep. Written with squared lengths: one square root in the
+// kinetic case, none in the static one.
+inline void applyFriction(const Mat3& to_unit_end, const Vec3& c_end, const Mat3& from_end,
+                          const Vec3& c_start, const Mat3& from_start, const Vec3& qc,
+                          const Vec3& before, const Vec3& x0, float mu_s, float mu_k, Vec3& x) {
+  const Vec3 n = mulvT(to_unit_end, qc);  // outward normal (unnormalised): gradient of |q|^2/2
+  const float nn = n.squaredNorm();
+  if (!(nn > 0.0f)) return;
+  const Vec3 surface_move = (c_end + mulv(from_end, qc)) - (c_start + mulv(from_start, qc));
+  const Vec3 rel = (x - x0) - surface_move;
+  const Vec3 tangential = rel - (rel.dot(n) / nn) * n;
+  const float slip2 = tangential.squaredNorm();
+  const float depth2 = (x - before).squaredNorm();
+  // Static (slip below mu_s * depth): remove all slip, the particle rides with the surface.
+  // Kinetic: remove mu_k * depth of it. Selected without a branch.
+  const float kinetic = slip2 > 0.0f ? std::min(mu_k * std::sqrt(depth2 / slip2), 1.0f) : 0.0f;
+  const float f = slip2 < mu_s * mu_s * depth2 ? 1.0f : kinetic;
+  x -= f * tangential;
+}
+
+// A swept contact is answered at the entry point when the discrete response would land more
+// than 45 degrees (round the unit sphere) away from it.
+constexpr float kDeepContactCos = 0.70710678f;
+
+// Where the unit-space segment q0 -> q1 (q0 outside or on the sphere) first meets the unit
+// sphere, normalised onto it.
+inline Vec3 entryPoint(const Vec3& q0, float q0sq, const Vec3& q1) {
+  const Vec3 d = q1 - q0;
+  const float a = d.squaredNorm(), b = q0.dot(d), c0 = q0sq - 1.0f;
+  float t = 0.0f;
+  if (c0 > 0.0f && a > 0.0f) {
+    const float den = -b + std::sqrt(std::max(b * b - a * c0, 0.0f));
+    t = den > 0.0f ? std::min(c0 / den, 1.0f) : 0.0f;
+  }
+  const Vec3 qe = q0 + t * d;
+  const float len = qe.norm();
+  return len > 0.0f ? Vec3(qe / len) : Vec3(q0);
+}
+
+}  // namespace
+
+Ellipsoid interpolateEllipsoid(const Ellipsoid& a, const Ellipsoid& b, float t) {
+  Ellipsoid e;
+  e.centre = a.centre + t * (b.centre - a.centre);
+  e.radii = a.radii + t * (b.radii - a.radii);
+  Quat qa(a.rotation), qb(b.rotation);
+  qa.normalize();
+  qb.normalize();
+  e.rotation = qa.slerp(t, qb).toRotationMatrix();
+  e.refresh();
+  return e;
+}
+
+Ellipsoid EllipsoidCollider::inflatedEnd(int i) const {
+  Ellipsoid e;
+  if (i < 0 || i >= count()) return e;
+  const Shape& s = shapes_[static_cast<size_t>(i)];
+  e.centre = s.end.centre;
+  e.rotation = s.rotation;
+  e.radii = s.radii;
+  e.refresh();
+  return e;
+}
+
+void EllipsoidCollider::setEllipsoids(const Ellipsoid* start, const Ellipsoid* end, int count,
+                                      float margin_m) {
+  grid_ = false;
+  if (!start || !end || count <= 0) {
+    shapes_.clear();
+    return;
+  }
+  margin_ = (margin_m >= 0.0f && std::isfinite(margin_m)) ? margin_m : 0.0f;
+  shapes_.resize(static_cast<size_t>(count));
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  grid_min_ = Vec3::Constant(kInf);
+  grid_max_ = Vec3::Constant(-kInf);
+  bool any = false;
+
+  auto build = [this](const Ellipsoid& e, Frame& f, Vec3& radii, Vec3& mn, Vec3& mx) {
+    for (int i = 0; i < 3; ++i) radii[i] = std::max(e.radii[i] + margin_, 1e-6f);
+    f.centre = e.centre;
+    f.to_unit = radii.cwiseInverse().asDiagonal() * e.rotation.transpose();
+    f.from_unit = e.rotation * radii.asDiagonal();
+    const Vec3 half = f.from_unit.rowwise().norm();
+    mn = e.centre - half;
+    mx = e.centre + half;
+    return isFinite(mn) && isFinite(mx) && isFinite(f.to_unit.rowwise().sum());
+  };
+
+  for (int k = 0; k < count; ++k) {
+    Shape& s = shapes_[static_cast<size_t>(k)];
+    Vec3 start_radii, start_min, start_max;
+    const bool ok = build(end[k], s.end, s.radii, s.end_min, s.end_max) &&
+                    build(start[k], s.start, start_radii, start_min, start_max);
+    s.rotation = end[k].rotation;
+    if (!ok) {  // never matches: empty boxes
+      s.end_min = s.swept_min = Vec3::Constant(kInf);
+      s.end_max = s.swept_max = Vec3::Constant(-kInf);
+      continue;
+    }
+    s.swept_min = s.end_min.cwiseMin(start_min);
+    s.swept_max = s.end_max.cwiseMax(start_max);
+    grid_min_ = grid_min_.cwiseMin(s.swept_min);
+    grid_max_ = grid_max_.cwiseMax(s.swept_max);
+    any = true;
+    int smallest = 0;
+    for (int i = 1; i < 3; ++i) {
+      if (s.radii[i] < s.radii[smallest]) smallest = i;
+    }
+    s.smallest_axis = smallest;
+    const float r_max = s.radii.maxCoeff();
+    // Depth along any ray from inside is at most (1 - |q|) * r_max, so |q| >= 1 - tol / r_max
+    // means "inside by at most tol".
+    const float tol = std::min(kPenetrationTolerance / r_max, 1.0f);
+    s.inside_tol2 = (1.0f - tol) * (1.0f - tol);
+    const float graze = std::min(0.5f * margin_ / r_max, 1.0f);
+    s.graze = (1.0f - graze) * (1.0f - graze);
+  }
+  if (!any || count > kMaxGridEllipsoids) return;
+
+  words_ = (count + 63) / 64;
+  // Near-cubic cells, about kGridCells of them over the union of the swept boxes (a body:
+  // ~8 cm cells), at most kGridMaxPerAxis along an axis and 2 * kGridCells in all, so the
+  // storage reserved below is never exceeded.
+  const Vec3 extent = (grid_max_ - grid_min_).cwiseMax(Vec3::Constant(1e-4f));
+  const float cell = std::cbrt(extent.prod() / static_cast<float>(kGridCells));
+  for (int a = 0; a < 3; ++a) {
+    const float cells_a = std::ceil(extent[a] / cell);
+    dims_[a] = cells_a >= static_cast<float>(kGridMaxPerAxis) ? kGridMaxPerAxis
+                                                               : std::max(1, static_cast<int>(cells_a));
+  }
+  while (dims_[0] * dims_[1] * dims_[2] > 2 * kGridCells) {
+    int* largest = std::max_element(dims_, dims_ + 3);
+    --*largest;
+  }
+  for (int a = 0; a < 3; ++a) grid_scale_[a] = static_cast<float>(dims_[a]) / extent[a];
+  const size_t capacity = static_cast<size_t>(2 * kGridCells * words_);
+  if (cells_.capacity() < capacity) cells_.reserve(capacity);
+  cell_origin_ = Eigen::Array4f(grid_min_.x(), grid_min_.y(), grid_min_.z(), 0.0f);
+  cell_scale_ = Eigen::Array4f(grid_scale_.x(), grid_scale_.y(), grid_scale_.z(), 0.0f);
+  // Largest float that still truncates to dims - 1.
+  cell_top_ = Eigen::Array4f(std::nextafter(static_cast<float>(dims_[0]), 0.0f),
+                             std::nextafter(static_cast<float>(dims_[1]), 0.0f),
+                             std::nextafter(static_cast<float>(dims_[2]), 0.0f), 0.0f);
+  cells_.assign(static_cast<size_t>(dims_[0] * dims_[1] * dims_[2] * words_), 0);
+  for (int k = 0; k < count; ++k) {
+    const Shape& s = shapes_[static_cast<size_t>(k)];
+    if (!(s.swept_min.x() <= s.swept_max.x())) continue;
+    const Eigen::Array4i lo = cellsOf(s.swept_min, cell_origin_, cell_scale_, cell_top_);
+    const Eigen::Array4i hi = cellsOf(s.swept_max, cell_origin_, cell_scale_, cell_top_);
+    const uint64_t bit = uint64_t{1} << (k & 63);
+    for (int z = lo[2]; z <= hi[2]; ++z) {
+      for (int y = lo[1]; y <= hi[1]; ++y) {
+        for (int x = lo[0]; x <= hi[0]; ++x) {
+          cells_[static_cast<size_t>(((z * dims_[1] + y) * dims_[0] + x) * words_ + (k >> 6))] |= bit;
+        }
+      }
+    }
+  }
+  grid_ = true;
+}
+
+#if defined(__GNUC__)
+#define DRAPE_ALWAYS_INLINE __attribute__((always_inline)) inline
+#else
+#define DRAPE_ALWAYS_INLINE inline
+#endif
+
+DRAPE_ALWAYS_INLINE bool EllipsoidCollider::gather(const Vec3& lo, const Vec3& hi, bool use_grid,
+                                                   Candidates& c) const {
+  if (!overlaps(lo, hi, grid_min_, grid_max_)) return false;  // outside every swept box
+  c.all = !use_grid;
+  if (c.all) return true;
+  c.lo = cellsOf(lo, cell_origin_, cell_scale_, cell_top_);
+  c.hi = cellsOf(hi, cell_origin_, cell_scale_, cell_top_);
+  if (words_ == 1 && (c.lo == c.hi).all()) {
+    c.mask[0] = cells_[static_cast<size_t>((c.lo[2] * dims_[1] + c.lo[1]) * dims_[0] + c.lo[0])];
+    return true;
+  }
+  for (int w = 0; w < words_; ++w) c.mask[w] = 0;
+  for (int z = c.lo[2]; z <= c.hi[2]; ++z) {
+    for (int y = c.lo[1]; y <= c.hi[1]; ++y) {
+      for (int x = c.lo[0]; x <= c.hi[0]; ++x) {
+        const uint64_t* cell = &cells_[static_cast<size_t>(((z * dims_[1] + y) * dims_[0] + x) * words_)];
+        for (int w = 0; w < words_; ++w) c.mask[w] |= cell[w];
+      }
+    }
+  }
+  return true;
+}
+
+bool EllipsoidCollider::covers(const Candidates& c, const Vec3& p) const {
+  if (c.all) return true;
+  const Eigen::Array4i i = cellsOf(p, cell_origin_, cell_scale_, cell_top_);
+  return (i >= c.lo).all() && (i <= c.hi).all();
+}
+
+template <class F>
+void EllipsoidCollider::iterate(const Candidates& c, F&& f) const {
+  if (c.all) {
+    const int n = count();
+    for (int k = 0; k < n; ++k) f(k);
+    return;
+  }
+  for (int w = 0; w < words_; ++w) {
+    uint64_t m = c.mask[w];
+    while (m) {
+      const int k = (w << 6) + lowestBit(m);
+      m &= m - 1;
+      f(k);
+    }
+  }
+}
+
+template <class F>
+void EllipsoidCollider::forCandidates(const Vec3& lo, const Vec3& hi, bool use_grid, F&& f) const {
+  Candidates c;
+  if (gather(lo, hi, use_grid, c)) iterate(c, f);
+}
+
+int EllipsoidCollider::firstContaining(const Vec3& x, bool use_grid, CollisionStats& st) const {
+  int found = -1;
+  forCandidates(x, x, use_grid, [&](int k) {
+    if (found >= 0) return;
+    const Shape& s = shapes_[static_cast<size_t>(k)];
+    if (!containsPoint(s.end_min, s.end_max, x)) return;
+    ++st.tests;
+    if (mulv(s.end.to_unit, x - s.end.centre).squaredNorm() < s.inside_tol2) found = k;
+  });
+  return found;
+}
+
+Vec3 EllipsoidCollider::respond(const Shape& s, const Vec3& x, const Vec3& q, float r2,
+                                ContactResponse mode, Vec3& q_contact) const {
+  if (mode == ContactResponse::Radial) {
+    // Paper eq. 9-10; at the exact centre, push along the smallest axis (the nearest exit).
+    q_contact = r2 > 1e-30f ? Vec3(q / std::sqrt(r2)) : Vec3(Vec3::Unit(s.smallest_axis));
+    return s.end.centre + mulv(s.end.from_unit, q_contact);
+  }
+  const Vec3 local = mulvT(s.rotation, x - s.end.centre);
+  const Vec3 y = closestPointOnEllipsoidFast(s.radii, local);
+  q_contact = y.cwiseQuotient(s.radii);
+  return s.end.centre + mulv(s.rotation, y);
+}
+
+Vec3 EllipsoidCollider::slideFromEntry(const Shape& s, const Vec3& qe, const Vec3& q1,
+                                       Vec3& q_contact) const {
+  // Time of impact, then slide: from the entry point the rest of the relative motion continues
+  // in the tangent plane there (its inward normal part is what the contact removes).
+  const Vec3 xe = s.end.centre + mulv(s.end.from_unit, qe);
+  Vec3 n = mulvT(s.end.to_unit, qe);
+  const float nn = n.norm();
+  Vec3 rest = mulv(s.end.from_unit, q1 - qe);
+  if (nn > 0.0f) {
+    n /= nn;
+    const float rn = rest.dot(n);
+    if (rn < 0.0f) rest -= rn * n;
+  }
+  const Vec3 x = xe + rest;
+  q_contact = mulv(s.end.to_unit, x - s.end.centre);
+  return x;
+}
+
+void EllipsoidCollider::escape(Vec3& x, ContactResponse mode, bool use_grid,
+                               CollisionStats& st) const {
+  // x is inside one or more overlapping ellipsoids after the sequential passes (pushes out of
+  // one keep landing in another). Candidates: the response target of each ellipsoid containing
+  // x (up to 8). Take the nearest target that is outside every ellipsoid; if there is none,
+  // march from x along each push direction to the first point outside every ellipsoid (along a
+  // ray each ellipsoid covers one interval, so jumping to the exit of whichever contains the
+  // current point ends after at most count() jumps) and take the shortest march.
+  constexpr int kMaxCandidates = 8;
+  int containing[kMaxCandidates];
+  Vec3 targets[kMaxCandidates];
+  int m = 0;
+  forCandidates(x, x, use_grid, [&](int k) {
+    if (m == kMaxCandidates) return;
+    const Shape& s = shapes_[static_cast<size_t>(k)];
+    if (!containsPoint(s.end_min, s.end_max, x)) return;
+    ++st.tests;
+    const Vec3 q = mulv(s.end.to_unit, x - s.end.centre);
+    const float r2 = q.squaredNorm();
+    if (!(r2 < s.inside_tol2)) return;
+    Vec3 qc;
+    targets[m] = respond(s, x, q, r2, mode, qc);
+    containing[m++] = k;
+  });
+  float best = std::numeric_limits<float>::infinity();
+  Vec3 best_x = x;
+  for (int i = 0; i < m; ++i) {
+    const float d = (targets[i] - x).squaredNorm();
+    if (d < best && firstContaining(targets[i], use_grid, st) < 0) {
+      best = d;
+      best_x = targets[i];
+    }
+  }
+  if (best < std::numeric_limits<float>::infinity()) {
+    x = best_x;
+    return;
+  }
+  const int n = count();
+  for (int i = 0; i < m; ++i) {
+    const Shape& s0 = shapes_[static_cast<size_t>(containing[i])];
+    Vec3 dir = targets[i] - x;
+    const float len = dir.norm();
+    dir = len > 1e-12f ? Vec3(dir / len) : Vec3(s0.rotation.col(s0.smallest_axis));
+    float t = 0.0f;
+    bool out = false;
+    for (int jump = 0; jump <= n && t * t < best; ++jump) {
+      const Vec3 p = x + t * dir;
+      const int k = firstContaining(p, use_grid, st);
+      if (k < 0) {
+        out = true;
+        break;
+      }
+      const Shape& s = shapes_[static_cast<size_t>(k)];
+      const Vec3 q = mulv(s.end.to_unit, p - s.end.centre);
+      const Vec3 v = mulv(s.end.to_unit, dir);
+      const float a = v.squaredNorm(), b = q.dot(v), c = q.squaredNorm() - 1.0f;
+      const float step = a > 0.0f ? (-b + std::sqrt(std::max(b * b - a * c, 0.0f))) / a : 0.0f;
+      t += std::max(step, 1e-7f) * 1.000001f;
+    }
+    if (out && t * t < best) {
+      best = t * t;
+      best_x = x + t * dir;
+    }
+  }
+  x = best_x;
+}
+
+void EllipsoidCollider::resolveParticle(Vec3& x, const Vec3& x0, bool has_prev,
+                                        const CollisionParams& p, CollisionStats& st) const {
+  const bool cont = p.continuous && has_prev;
+  const bool friction = has_prev && (p.static_friction > 0.0f || p.kinetic_friction > 0.0f);
+  const bool use_grid = p.broad_phase && grid_;
+  // Every visitor below first applies the per-ellipsoid AABB test, which every ellipsoid the grid
+  // leaves out fails: with and without the grid the same ellipsoids are tested in the same
+  // order, so both modes give bit-identical results.
+
+  // Pass 0: discrete test at the substep end, swept test, friction.
+  const Vec3 lo = cont ? x.cwiseMin(x0) : x;
+  const Vec3 hi = cont ? x.cwiseMax(x0) : x;
+  const Vec3 x_end = x;
+  bool moved = false;
+  Candidates first;
+  if (!gather(lo, hi, use_grid, first)) return;
+  iterate(first, [&](int k) {
+    const Shape& s = shapes_[static_cast<size_t>(k)];
+    const bool in_box = cont ? overlaps(lo, hi, s.swept_min, s.swept_max)
+                             : containsPoint(s.end_min, s.end_max, x_end);
+    if (!in_box) return;
+    ++st.tests;
+    // Past the box test, no contact is decided with one branch: the discrete and the swept
+    // tests are both evaluated and combined.
+    const Vec3 q1 = mulv(s.end.to_unit, x - s.end.centre);
+    const float r2 = q1.squaredNorm();
+    const bool inside = r2 < 1.0f;
+    Vec3 q0 = Vec3::Zero();
+    float q0sq = 0.0f;
+    bool crossed = false;
+    if (cont) {
+      // Outside at both ends: did the relative path q0 -> q1 pass through the unit ball (deeper
+      // than the graze threshold)? Closest approach^2 = q0sq - b^2 / a, compared times a.
+      q0 = mulv(s.start.to_unit, x0 - s.start.centre);
+      q0sq = q0.squaredNorm();
+      const Vec3 d = q1 - q0;
+      const float a = d.squaredNorm(), b = q0.dot(d);
+      crossed = !inside & (q0sq >= 1.0f) & (b < 0.0f) & (a > 0.0f) & (-b <= a) &
+                (q0sq * a - b * b < s.graze * a);
+    }
+    if (!(inside | crossed)) return;
+    Vec3 target, qc;
+    bool hit = true, swept = false;
+    if (inside) {
+      target = respond(s, x, q1, r2, p.response, qc);
+      // Entered during this substep: if the discrete push would move it far round the surface
+      // from where it came in (it went deep, e.g. a fast limb), use the entry point.
+      if (cont && q0sq >= s.inside_tol2) {
+        const Vec3 qe = entryPoint(q0, q0sq, q1);
+        if (qc.dot(qe) < kDeepContactCos) {
+          target = slideFromEntry(s, qe, q1, qc);
+          swept = true;
+        }
+      }
+    } else {
+      target = slideFromEntry(s, entryPoint(q0, q0sq, q1), q1, qc);
+      swept = true;
+    }
+    if (!hit) return;
+    ++st.contacts;
+    if (swept) ++st.swept_catches;
+    const Vec3 before = x;
+    x = target;
+    if (friction) {
+      applyFriction(s.end.to_unit, s.end.centre, s.end.from_unit, s.start.centre,
+                    s.start.from_unit, qc, before, x0, p.static_friction, p.kinetic_friction, x);
+    }
+    moved = true;
+  });
+
+  // Further sequential passes (no friction): a push out of one ellipsoid may land in another.
+  // The first pass's candidates still cover x when it stayed in the same cells (the usual case).
+  for (int pass = 1; pass < kSequentialPasses && moved; ++pass) {
+    moved = false;
+    const Vec3 xp = x;
+    Candidates again;
+    const Candidates* c = &first;
+    if (!covers(first, xp)) {
+      if (!gather(xp, xp, use_grid, again)) break;
+      c = &again;
+    }
+    iterate(*c, [&](int k) {
+      const Shape& s = shapes_[static_cast<size_t>(k)];
+      if (!containsPoint(s.end_min, s.end_max, xp)) return;
+      ++st.tests;
+      const Vec3 q = mulv(s.end.to_unit, x - s.end.centre);
+      const float r2 = q.squaredNorm();
+      if (!(r2 < s.inside_tol2)) return;
+      Vec3 qc;
+      x = respond(s, x, q, r2, p.response, qc);
+      moved = true;
+    });
+  }
+  // Guarantee: if the last pass moved the particle, check it; still inside -> escape step.
+  if (moved && firstContaining(x, use_grid, st) >= 0) {
+    escape(x, p.response, use_grid, st);
+    ++st.escapes;
+  }
+}
+
+CollisionStats EllipsoidCollider::collide(Eigen::Vector4f* positions,
+                                          const Eigen::Vector4f* previous, size_t count,
+                                          const CollisionParams& params) const {
+  CollisionStats st;
+  if (!positions || shapes_.empty()) return st;
+  // Friction coefficients outside [0, 1e6] (negative, NaN, infinite) are clamped.
+  CollisionParams p = params;
+  p.static_friction = p.static_friction > 0.0f ? std::min(p.static_friction, 1e6f) : 0.0f;
+  p.kinetic_friction = p.kinetic_friction > 0.0f ? std::min(p.kinetic_friction, 1e6f) : 0.0f;
+  const bool swept = p.continuous && previous != nullptr;
+  for (size_t i = 0; i < count; ++i) {
+    if (!(positions[i].w() > 0.0f)) continue;
+    const Vec3 x = positions[i].head<3>();
+    // Cheap reject before anything else: nowhere near any ellipsoid's (swept) box. NaN fails
+    // every comparison and is rejected here too, unless the previous position is finite.
+    if (!containsPoint(grid_min_, grid_max_, x)) {
+      if (!swept) continue;
+      const Vec3 p0 = previous[i].head<3>();
+      if (!overlaps(x.cwiseMin(p0), x.cwiseMax(p0), grid_min_, grid_max_)) continue;
+    }
+    if (!isFinite(x)) continue;
+    Vec3 x0 = x;
+    bool has_prev = false;
+    if (previous) {
+      x0 = previous[i].head<3>();
+      has_prev = isFinite(x0);
+      if (!has_prev) x0 = x;
+    }
+    Vec3 y = x;
+    resolveParticle(y, x0, has_prev, p, st);
+    if (y != x) positions[i].head<3>() = y;
+  }
+  return st;
+}
+
+}  // namespace drape

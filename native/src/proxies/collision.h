@@ -1,0 +1,128 @@
+// Particle–ellipsoid collision (paper §3.3, eq. 7-10) with what Drape adds: an exact closest-point
+// response, Coulomb friction against the moving surface, a swept (continuous) test between the
+// substep's start and end, and a uniform-grid broad phase. Array-oriented: the cloth solver calls
+// collide() once per substep on all its particles. Method, choices and figures: docs/collision.md.
+//
+// Threading: setEllipsoids() writes the collider; collide() is const, touches no shared mutable
+// state and allocates nothing, so several threads may call it at once on disjoint particle ranges.
+#pragma once
+
+#include "common/math.h"
+#include "proxies/ellipsoid.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace drape {
+
+enum class ContactResponse : int {
+  Radial = 0,  // the paper: q = E^-1 x, move to q/|q| (radial projection in unit space)
+  Exact = 1,   // closest point on the (margin-inflated) ellipsoid surface
+};
+
+struct CollisionParams {
+  ContactResponse response = ContactResponse::Exact;
+  float static_friction = 0.6f;   // mu_s: tangential slip below mu_s * depth is cancelled
+  float kinetic_friction = 0.4f;  // mu_k: otherwise slip is reduced by mu_k * depth
+  bool continuous = true;         // swept test between the substep's start and end
+  bool broad_phase = true;        // grid culling; off = test every ellipsoid (same results)
+};
+
+struct CollisionStats {
+  uint32_t tests = 0;          // narrow-phase particle–ellipsoid tests (after the AABB reject)
+  uint32_t contacts = 0;       // corrections in the first pass (discrete contacts + swept catches)
+  uint32_t swept_catches = 0;  // of those, placed at a swept entry point
+  uint32_t escapes = 0;        // particles still inside after kSequentialPasses (overlaps),
+                               // resolved by the escape step
+};
+
+// The ellipsoid at fraction t of a substep: centre and radii interpolated linearly, rotation by
+// quaternion slerp (shortest arc), then refresh().
+Ellipsoid interpolateEllipsoid(const Ellipsoid& a, const Ellipsoid& b, float t);
+
+class EllipsoidCollider {
+ public:
+  static constexpr float kDefaultMargin = 0.004f;
+  static constexpr int kGridCells = 1024;               // about this many near-cubic cells
+  static constexpr int kGridMaxPerAxis = 32;
+  static constexpr int kMaxGridEllipsoids = 256;        // more: broad phase off (still correct)
+  static constexpr float kPenetrationTolerance = 1e-5f; // metres, guaranteed after collide()
+  static constexpr int kSequentialPasses = 2;           // then the escape step
+
+  // Ellipsoids at the start and at the end of the current substep (same count and order; only
+  // centre, rotation and radii are read). Each is inflated by `margin_m` (the gap kept between a
+  // particle and the surface, i.e. the cloth thickness:
+  // radii + margin, see docs/collision.md for the error of that approximation), and the grid is
+  // rebuilt. Allocates only when `count` grows; call once per substep. count <= 0 or null
+  // pointers: no ellipsoids.
+  void setEllipsoids(const Ellipsoid* start, const Ellipsoid* end, int count,
+                     float margin_m = kDefaultMargin);
+
+  // positions: predicted positions at the substep end, xyz corrected in place; w = inverse mass,
+  // particles with !(w > 0) (pinned) or a non-finite position are not touched.
+  // previous: positions at the substep start (w ignored), used for friction and the swept test;
+  // may be null (then neither). Particles are independent: the result for one particle does not
+  // depend on the others or on their order.
+  CollisionStats collide(Eigen::Vector4f* positions, const Eigen::Vector4f* previous, size_t count,
+                         const CollisionParams& params) const;
+
+  int count() const { return static_cast<int>(shapes_.size()); }
+  float margin() const { return margin_; }
+  // The inflated ellipsoid at the substep end (what a particle must end outside of).
+  Ellipsoid inflatedEnd(int i) const;
+
+ private:
+  struct Frame {
+    Vec3 centre = Vec3::Zero();
+    Mat3 to_unit = Mat3::Identity();    // S^-1 R^T (inflated radii)
+    Mat3 from_unit = Mat3::Identity();  // R S
+  };
+  struct Shape {
+    Frame end, start;
+    Mat3 rotation = Mat3::Identity();  // end rotation
+    Vec3 radii = Vec3::Ones();         // end radii, inflated
+    Vec3 end_min, end_max;             // AABB of the inflated end ellipsoid
+    Vec3 swept_min, swept_max;         // union of the inflated start and end AABBs
+    float inside_tol2 = 1.0f;          // |q|^2 below this: inside by more than the tolerance
+    float graze = 0.0f;                // swept chords shallower than this (unit space) ignored
+    int smallest_axis = 0;
+  };
+  using Mask = uint64_t[kMaxGridEllipsoids / 64];
+
+  // Candidate ellipsoids for a box: the union of the masks of the cells it touches (grid) or all.
+  struct Candidates {
+    Mask mask;
+    Eigen::Array4i lo, hi;  // cell range (w lane unused)
+    bool all;
+  };
+  // False when the box misses every swept box. Otherwise fills c.
+  bool gather(const Vec3& lo, const Vec3& hi, bool use_grid, Candidates& c) const;
+  // Whether c's cells include the cell of p (then c's candidates include p's).
+  bool covers(const Candidates& c, const Vec3& p) const;
+  // Calls f(k) for the candidates in increasing k.
+  template <class F>
+  void iterate(const Candidates& c, F&& f) const;
+  template <class F>
+  void forCandidates(const Vec3& lo, const Vec3& hi, bool use_grid, F&& f) const;
+  // First ellipsoid (in index order) containing x by more than the tolerance, or -1.
+  int firstContaining(const Vec3& x, bool use_grid, CollisionStats& stats) const;
+  void resolveParticle(Vec3& x, const Vec3& x0, bool has_prev, const CollisionParams& p,
+                       CollisionStats& stats) const;
+  Vec3 respond(const Shape& s, const Vec3& x, const Vec3& q, float r2, ContactResponse mode,
+               Vec3& q_contact) const;
+  Vec3 slideFromEntry(const Shape& s, const Vec3& qe, const Vec3& q1, Vec3& q_contact) const;
+  void escape(Vec3& x, ContactResponse mode, bool use_grid, CollisionStats& stats) const;
+
+  std::vector<Shape> shapes_;
+  std::vector<uint64_t> cells_;  // dims_ cells (x fastest) x words_ bitmask words
+  int dims_[3] = {1, 1, 1};
+  int words_ = 0;
+  bool grid_ = false;
+  Vec3 grid_min_ = Vec3::Zero(), grid_max_ = Vec3::Zero(), grid_scale_ = Vec3::Zero();
+  Eigen::Array4f cell_origin_ = Eigen::Array4f::Zero(), cell_scale_ = Eigen::Array4f::Zero(),
+                 cell_top_ = Eigen::Array4f::Zero();
+  float margin_ = kDefaultMargin;
+};
+
+}  // namespace drape

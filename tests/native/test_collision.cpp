@@ -1,0 +1,832 @@
+// Particle–ellipsoid collision (native/src/proxies/collision.h, closest_point.h).
+#include "proxies/closest_point.h"
+#include "proxies/collision.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <vector>
+
+namespace drape {
+namespace {
+
+using Vec4 = Eigen::Vector4f;
+using V3d = Eigen::Vector3d;
+
+// ---------------------------------------------------------------------------------------------
+// Brute-force reference: sample the surface e ∘ u(θ, φ) densely, then refine the best samples by
+// pattern search in (θ, φ) with a shrinking step, all in double. `point_on` maps a local surface
+// point to the frame `p` is given in (identity for local tests, a rigid transform for rotated).
+template <class Map>
+double bruteDistance(const V3d& e, const V3d& p, Map point_on) {
+  // Polar axis = the longest radius, so that along an elongated ellipsoid theta moves along the
+  // long axis and phi around it: the distance's valleys are then aligned with the parameters.
+  int pa = 0;
+  for (int i = 1; i < 3; ++i) {
+    if (e[i] > e[pa]) pa = i;
+  }
+  const int pb = (pa + 1) % 3, pc = (pa + 2) % 3;
+  auto unitAt = [&](double st, double ct, double sp, double cp) {
+    V3d u;
+    u[pa] = ct;
+    u[pb] = st * cp;
+    u[pc] = st * sp;
+    return u;
+  };
+  auto dist = [&](double th, double ph) {
+    const V3d u = unitAt(std::sin(th), std::cos(th), std::sin(ph), std::cos(ph));
+    return (point_on(V3d(e.cwiseProduct(u))) - p).norm();
+  };
+  constexpr int kTh = 200, kPh = 400;
+  static std::vector<double> sth, cth, sph, cph;
+  if (sth.empty()) {
+    for (int i = 0; i <= kTh; ++i) {
+      sth.push_back(std::sin(M_PI * i / kTh));
+      cth.push_back(std::cos(M_PI * i / kTh));
+    }
+    for (int j = 0; j < kPh; ++j) {
+      sph.push_back(std::sin(2.0 * M_PI * j / kPh));
+      cph.push_back(std::cos(2.0 * M_PI * j / kPh));
+    }
+  }
+  // Best sample per octant of the parameter sphere so every basin is refined.
+  double best_d[8], best_th[8], best_ph[8];
+  for (int i = 0; i < 8; ++i) best_d[i] = std::numeric_limits<double>::infinity();
+  for (int i = 0; i <= kTh; ++i) {
+    for (int j = 0; j < kPh; ++j) {
+      const V3d u = unitAt(sth[i], cth[i], sph[j], cph[j]);
+      const double d = (point_on(V3d(e.cwiseProduct(u))) - p).squaredNorm();
+      const int oct = (cth[i] >= 0 ? 1 : 0) | (cph[j] >= 0 ? 2 : 0) | (sph[j] >= 0 ? 4 : 0);
+      if (d < best_d[oct]) {
+        best_d[oct] = d;
+        best_th[oct] = M_PI * i / kTh;
+        best_ph[oct] = 2.0 * M_PI * j / kPh;
+      }
+    }
+  }
+  double result = std::numeric_limits<double>::infinity();
+  for (int o = 0; o < 8; ++o) {
+    if (!std::isfinite(best_d[o])) continue;
+    double th = best_th[o], ph = best_ph[o], d = dist(th, ph);
+    double step = M_PI / kTh;
+    for (int it = 0; it < 100000 && step > 1e-13; ++it) {
+      double bt = th, bp = ph, bd = d;
+      for (int a = -1; a <= 1; ++a) {
+        for (int b = -1; b <= 1; ++b) {
+          const double dd = dist(th + a * step, ph + b * step);
+          if (dd < bd) {
+            bd = dd;
+            bt = th + a * step;
+            bp = ph + b * step;
+          }
+        }
+      }
+      if (bt == th && bp == ph) step *= 0.5;
+      th = bt;
+      ph = bp;
+      d = bd;
+    }
+    result = std::min(result, d);
+  }
+  return result;
+}
+
+double bruteLocal(const Vec3& radii, const Vec3& p) {
+  return bruteDistance(radii.cast<double>(), p.cast<double>(), [](const V3d& x) { return x; });
+}
+
+// Points to test against ellipsoid `r`: random inside/outside, on every axis (inside, on the
+// surface, outside), the centre, in the coordinate planes, on and just off the surface.
+std::vector<Vec3> probePoints(const Vec3& r, std::mt19937& rng, int random_count) {
+  std::vector<Vec3> pts;
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::uniform_real_distribution<float> scale(0.05f, 2.5f);
+  for (int i = 0; i < random_count; ++i) {
+    Vec3 d(u(rng), u(rng), u(rng));
+    if (d.norm() < 1e-3f) continue;
+    d.normalize();
+    pts.push_back(r.cwiseProduct(d) * scale(rng));
+  }
+  pts.push_back(Vec3::Zero());
+  for (int a = 0; a < 3; ++a) {
+    for (float f : {0.01f, 0.3f, 0.7f, 0.999f, 1.0f, 1.5f, -0.5f}) {
+      Vec3 p = Vec3::Zero();
+      p[a] = f * r[a];
+      pts.push_back(p);
+    }
+  }
+  // Coordinate planes (one coordinate exactly zero), inside and outside.
+  for (int a = 0; a < 3; ++a) {
+    for (float f : {0.2f, 0.6f, 1.3f}) {
+      Vec3 p = r * f * 0.57735f;
+      p[a] = 0.0f;
+      pts.push_back(p);
+      p[(a + 1) % 3] = -p[(a + 1) % 3];
+      pts.push_back(p);
+    }
+  }
+  // On the surface and 1 mm inside / outside it.
+  for (int i = 0; i < 6; ++i) {
+    Vec3 d(u(rng), u(rng), u(rng));
+    d.normalize();
+    const Vec3 s = r.cwiseProduct(d);
+    const Vec3 n = s.cwiseQuotient(r.cwiseProduct(r)).normalized();
+    pts.push_back(s);
+    pts.push_back(s + 1e-3f * n);
+    pts.push_back(s - 1e-3f * n * std::min(1.0f, r.minCoeff() * 0.5f / 1e-3f));
+  }
+  return pts;
+}
+
+const Vec3 kShapes[] = {
+    Vec3(0.1f, 0.1f, 0.1f),     // sphere
+    Vec3(0.05f, 0.15f, 0.05f),  // prolate 3:1 (a limb)
+    Vec3(0.2f, 0.2f, 0.05f),    // oblate 4:1
+    Vec3(0.3f, 0.1f, 0.02f),    // triaxial
+    Vec3(1.0f, 0.01f, 0.01f),   // 100:1 needle
+    Vec3(0.01f, 1.0f, 0.5f),    // 100:1 flat, permuted axes
+};
+
+TEST(ClosestPoint, MatchesBruteForceLocal) {
+  std::mt19937 rng(7);
+  for (const Vec3& r : kShapes) {
+    for (const Vec3& p : probePoints(r, rng, 12)) {
+      const double ref = bruteLocal(r, p);
+      for (int method = 0; method < 2; ++method) {
+        float d = -1.0f;
+        const Vec3 x = method == 0 ? closestPointOnEllipsoid(r, p, &d)
+                                   : closestPointOnEllipsoidFast(r, p, &d);
+        SCOPED_TRACE(::testing::Message() << "radii " << r.transpose() << " p " << p.transpose()
+                                          << (method == 0 ? " bisection" : " fast"));
+        ASSERT_TRUE(isFinite(x));
+        EXPECT_NEAR(d, ref, 1e-5 * std::max(ref, 1e-4));
+        // The point returned is on the surface and at the distance returned.
+        EXPECT_NEAR(x.cwiseQuotient(r).norm(), 1.0f, 2e-6f);
+        EXPECT_NEAR((x - p).norm(), d, 2e-6f * r.maxCoeff());
+      }
+    }
+  }
+}
+
+TEST(ClosestPoint, MatchesBruteForceRotated) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (const Vec3& r : kShapes) {
+    for (int rep = 0; rep < 2; ++rep) {
+      const Quat rot = Quat(Eigen::Vector4f(u(rng), u(rng), u(rng), u(rng)).normalized());
+      const Mat3 R = rot.toRotationMatrix();
+      const Vec3 c = Vec3(u(rng), u(rng), u(rng)) * 0.01f;
+      for (const Vec3& local : probePoints(r, rng, 4)) {
+        const Vec3 p = c + R * local;
+        const Vec3 l = R.transpose() * (p - c);
+        float d = 0.0f;
+        const Vec3 y = closestPointOnEllipsoid(r, l, &d);
+        const Vec3 x = c + R * y;
+        const Eigen::Matrix3d Rd = R.cast<double>();
+        const V3d cd = c.cast<double>();
+        const double ref = bruteDistance(r.cast<double>(), p.cast<double>(),
+                                         [&](const V3d& s) { return V3d(cd + Rd * s); });
+        SCOPED_TRACE(::testing::Message() << "radii " << r.transpose() << " local " << local.transpose());
+        // The float transforms round coordinates (~1e-7 of the size), so the relative tolerance
+        // has a floor at 5e-7 of the ellipsoid's largest radius.
+        EXPECT_NEAR((x - p).norm(), ref, 1e-5 * std::max(ref, 0.05 * r.maxCoeff()));
+      }
+    }
+  }
+}
+
+TEST(ClosestPoint, FastAgreesWithBisection) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), lr(-2.5f, 1.0f);
+  double worst = 0.0;
+  for (int i = 0; i < 200000; ++i) {
+    const Vec3 r(std::pow(10.0f, lr(rng)) * 0.1f, std::pow(10.0f, lr(rng)) * 0.1f,
+                 std::pow(10.0f, lr(rng)) * 0.1f);
+    const Vec3 p = r.cwiseProduct(Vec3(u(rng), u(rng), u(rng))) * 1.5f;
+    float d0 = 0.0f, d1 = 0.0f;
+    const Vec3 a = closestPointOnEllipsoid(r, p, &d0);
+    const Vec3 b = closestPointOnEllipsoidFast(r, p, &d1);
+    worst = std::max(worst, static_cast<double>(std::fabs(d0 - d1)) / std::max(d0, 1e-6f * r.maxCoeff()));
+    ASSERT_LE((a - b).norm(), 1e-5f * r.maxCoeff()) << r.transpose() << " | " << p.transpose();
+  }
+  EXPECT_LT(worst, 1e-5);
+  std::printf("[ closest  ] fast (Halley) vs bisection, 200k random points: max relative distance difference %.2e\n", worst);
+}
+
+TEST(ClosestPoint, DegenerateInputs) {
+  float d = -1.0f;
+  // Centre of a sphere: some surface point at distance r.
+  Vec3 x = closestPointOnEllipsoid(Vec3(0.1f, 0.1f, 0.1f), Vec3::Zero(), &d);
+  EXPECT_NEAR(x.norm(), 0.1f, 1e-7f);
+  EXPECT_NEAR(d, 0.1f, 1e-7f);
+  // Centre of an ellipsoid: the ends of the smallest axis.
+  x = closestPointOnEllipsoidFast(Vec3(0.3f, 0.05f, 0.1f), Vec3::Zero(), &d);
+  EXPECT_NEAR(std::fabs(x.y()), 0.05f, 1e-7f);
+  EXPECT_NEAR(d, 0.05f, 1e-7f);
+  // Invalid radii or point: returned unchanged, distance 0, no NaN invented.
+  const Vec3 p(0.1f, 0.2f, 0.3f);
+  EXPECT_EQ(closestPointOnEllipsoid(Vec3(0.0f, 1.0f, 1.0f), p, &d), p);
+  EXPECT_EQ(d, 0.0f);
+  EXPECT_EQ(closestPointOnEllipsoid(Vec3(-1.0f, 1.0f, 1.0f), p, &d), p);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(closestPointOnEllipsoidFast(Vec3(nan, 1.0f, 1.0f), p, &d), p);
+  const Vec3 bad(nan, 0.0f, 0.0f);
+  const Vec3 r = closestPointOnEllipsoid(Vec3::Ones(), bad, &d);
+  EXPECT_TRUE(std::isnan(r.x()));
+  EXPECT_EQ(d, 0.0f);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Collider helpers.
+
+Ellipsoid makeEllipsoid(const Vec3& c, const Vec3& radii, const Mat3& R = Mat3::Identity()) {
+  Ellipsoid e;
+  e.centre = c;
+  e.radii = radii;
+  e.rotation = R;
+  e.refresh();
+  return e;
+}
+
+// Exact penetration depth (metres) of p into ellipsoid e, 0 outside.
+float depthInside(const Ellipsoid& e, const Vec3& p) {
+  if (e.toUnit(p).squaredNorm() >= 1.0f) return 0.0f;
+  float d = 0.0f;
+  closestPointOnEllipsoid(e.radii, e.rotation.transpose() * (p - e.centre), &d);
+  return d;
+}
+
+float maxDepth(const EllipsoidCollider& c, const std::vector<Vec4>& x) {
+  float worst = 0.0f;
+  for (const Vec4& p : x) {
+    if (!(p.w() > 0.0f)) continue;
+    for (int k = 0; k < c.count(); ++k) worst = std::max(worst, depthInside(c.inflatedEnd(k), p.head<3>()));
+  }
+  return worst;
+}
+
+// Minimal position-based integrator: predict with velocity and acceleration, collide against the
+// substep's start/end ellipsoids, the prediction becomes the new position.
+struct Particles {
+  std::vector<Vec4> x, prev;
+  void add(const Vec3& p, float w = 1.0f) {
+    x.emplace_back(p.x(), p.y(), p.z(), w);
+    prev.push_back(x.back());
+  }
+  CollisionStats step(const EllipsoidCollider& c, const Vec3& accel, float dt, const CollisionParams& p,
+                      const std::vector<Vec3>* per_particle_accel = nullptr) {
+    for (size_t i = 0; i < x.size(); ++i) {
+      if (!(x[i].w() > 0.0f)) continue;
+      const Vec3 pos = x[i].head<3>();
+      const Vec3 v = (pos - prev[i].head<3>()) / dt;
+      const Vec3 a = per_particle_accel ? (*per_particle_accel)[i] : accel;
+      prev[i].head<3>() = pos;
+      x[i].head<3>() = pos + v * dt + a * dt * dt;
+    }
+    return c.collide(x.data(), prev.data(), x.size(), p);
+  }
+};
+
+TEST(Collider, InterpolateEllipsoid) {
+  const Ellipsoid a = makeEllipsoid(Vec3(0, 0, 0), Vec3(0.1f, 0.2f, 0.3f));
+  const Ellipsoid b = makeEllipsoid(Vec3(1, 2, 3), Vec3(0.3f, 0.2f, 0.1f),
+                                    Eigen::AngleAxisf(1.0f, Vec3::UnitY()).toRotationMatrix());
+  const Ellipsoid m = interpolateEllipsoid(a, b, 0.5f);
+  EXPECT_TRUE(m.centre.isApprox(Vec3(0.5f, 1.0f, 1.5f)));
+  EXPECT_TRUE(m.radii.isApprox(Vec3(0.2f, 0.2f, 0.2f)));
+  EXPECT_TRUE(m.rotation.isApprox(Eigen::AngleAxisf(0.5f, Vec3::UnitY()).toRotationMatrix(), 1e-5f));
+  EXPECT_TRUE(m.to_unit.isApprox(m.radii.cwiseInverse().asDiagonal() * m.rotation.transpose()));
+  const Ellipsoid e1 = interpolateEllipsoid(a, b, 1.0f);
+  EXPECT_TRUE(e1.rotation.isApprox(b.rotation, 1e-5f));
+  EXPECT_TRUE(e1.centre.isApprox(b.centre));
+}
+
+TEST(Collider, RadialVersusExact) {
+  // A 3:1 limb-like ellipsoid; particles everywhere inside it.
+  const Ellipsoid e = makeEllipsoid(Vec3(0.2f, 1.0f, -0.1f), Vec3(0.04f, 0.12f, 0.04f),
+                                    Eigen::AngleAxisf(0.7f, Vec3(1, 1, 0).normalized()).toRotationMatrix());
+  EllipsoidCollider col;
+  col.setEllipsoids(&e, &e, 1, 0.0f);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<Vec4> pts;
+  while (pts.size() < 20000) {
+    const Vec3 q(u(rng), u(rng), u(rng));
+    if (q.squaredNorm() >= 0.999f) continue;
+    pts.emplace_back(Vec4(0, 0, 0, 1));
+    pts.back().head<3>() = e.fromUnit(q);
+  }
+  std::vector<Vec4> radial = pts, exact = pts;
+  CollisionParams p;
+  p.continuous = false;
+  p.static_friction = p.kinetic_friction = 0.0f;
+  p.response = ContactResponse::Radial;
+  const CollisionStats sr = col.collide(radial.data(), nullptr, radial.size(), p);
+  p.response = ContactResponse::Exact;
+  const CollisionStats se = col.collide(exact.data(), nullptr, exact.size(), p);
+  EXPECT_EQ(sr.contacts, pts.size());
+  EXPECT_EQ(se.contacts, pts.size());
+  float max_diff = 0.0f, max_excess = 0.0f, max_ratio = 1.0f;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const Vec3 o = pts[i].head<3>();
+    const float dr = (radial[i].head<3>() - o).norm();
+    const float de = (exact[i].head<3>() - o).norm();
+    EXPECT_LE(de, dr + 1e-6f);  // exact is never farther than radial
+    max_diff = std::max(max_diff, (radial[i].head<3>() - exact[i].head<3>()).norm());
+    max_excess = std::max(max_excess, dr - de);
+    if (de > 1e-3f) max_ratio = std::max(max_ratio, dr / de);
+    EXPECT_LE(depthInside(e, exact[i].head<3>()), 1e-5f);
+    EXPECT_LE(depthInside(e, radial[i].head<3>()), 1e-5f);
+  }
+  std::printf("[ radial   ] 3:1 ellipsoid (4 x 12 x 4 cm), 20k points inside: max |radial - exact| = %.1f mm, "
+              "radial push up to %.1f mm (x%.2f) longer than the exact one\n",
+              max_diff * 1e3f, max_excess * 1e3f, max_ratio);
+  EXPECT_GT(max_diff, 1e-3f);  // the two responses really differ on an elongated ellipsoid
+}
+
+TEST(Collider, MarginInflationClearance) {
+  // Every point of the inflated surface (radii + m) is e∘u + m·u for a unit u, so its distance
+  // to the original ellipsoid is at most m; it is at least m·(u·n) >= m·2√(ab)/(a+b) (supporting
+  // plane). Measure the real minimum for growing elongation.
+  const float m = 0.004f;
+  for (float ratio : {1.0f, 3.0f, 10.0f, 100.0f}) {
+    const Vec3 r(0.04f * ratio, 0.04f, 0.04f);
+    float lo = std::numeric_limits<float>::infinity(), hi = 0.0f;
+    for (int i = 0; i <= 2000; ++i) {
+      const float th = kPi * static_cast<float>(i) / 2000.0f;
+      const Vec3 uvec(std::cos(th), std::sin(th), 0.0f);
+      const Vec3 s = (r + Vec3::Constant(m)).cwiseProduct(uvec);
+      float d = 0.0f;
+      closestPointOnEllipsoid(r, s, &d);
+      lo = std::min(lo, d);
+      hi = std::max(hi, d);
+    }
+    const float bound = 2.0f * std::sqrt(r.x() * r.y()) / (r.x() + r.y());
+    std::printf("[ margin   ] %5.0f:1 ellipsoid, margin 4 mm: clearance of the inflated surface %.2f .. %.2f mm "
+                "(plane bound %.2f mm)\n", ratio, lo * 1e3f, hi * 1e3f, bound * m * 1e3f);
+    EXPECT_LE(hi, m * 1.0001f);
+    EXPECT_GE(lo, bound * m * 0.999f);
+  }
+}
+
+struct Motion {
+  // Centre on a circle, rotation about a tilted axis.
+  Ellipsoid at(float t) const {
+    const Vec3 c(0.3f * std::cos(6.0f * t), 1.0f + 0.1f * std::sin(3.0f * t), 0.3f * std::sin(6.0f * t));
+    const Mat3 R = Eigen::AngleAxisf(4.0f * t, Vec3(0.3f, 1.0f, 0.2f).normalized()).toRotationMatrix();
+    return makeEllipsoid(c, Vec3(0.06f, 0.15f, 0.05f), R);
+  }
+};
+
+TEST(Collider, PressedParticlesNeverEndInsideMovingEllipsoid) {
+  const float dt = 1.0f / 240.0f;
+  const Motion motion;
+  for (int response = 0; response < 2; ++response) {
+    for (int cont = 0; cont < 2; ++cont) {
+      CollisionParams p;
+      p.response = static_cast<ContactResponse>(response);
+      p.continuous = cont != 0;
+      Particles ps;
+      std::mt19937 rng(17);
+      std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+      const Ellipsoid e0 = motion.at(0.0f);
+      for (int i = 0; i < 300; ++i) {
+        const Vec3 d = Vec3(u(rng), u(rng), u(rng)).normalized();
+        ps.add(e0.fromUnit(d * 1.3f));
+      }
+      EllipsoidCollider col;
+      float worst = 0.0f;
+      uint32_t contacts = 0;
+      std::vector<Vec3> accel(ps.x.size());
+      for (int s = 0; s < 960; ++s) {
+        const Ellipsoid a = motion.at(static_cast<float>(s) * dt), b = motion.at(static_cast<float>(s + 1) * dt);
+        col.setEllipsoids(&a, &b, 1);
+        for (size_t i = 0; i < ps.x.size(); ++i) {  // pulled hard towards the centre
+          accel[i] = (a.centre - ps.x[i].head<3>()).normalized() * 40.0f;
+        }
+        contacts += ps.step(col, Vec3::Zero(), dt, p, &accel).contacts;
+        worst = std::max(worst, maxDepth(col, ps.x));
+      }
+      SCOPED_TRACE(::testing::Message() << "response " << response << " continuous " << cont);
+      EXPECT_GT(contacts, 100000u);
+      EXPECT_LE(worst, EllipsoidCollider::kPenetrationTolerance);
+      for (const Vec4& x : ps.x) ASSERT_TRUE(x.allFinite());
+    }
+  }
+}
+
+// Random clusters of overlapping ellipsoids (armpit-like junctions): the guarantee holds after
+// one collide() however the particle starts.
+TEST(Collider, OverlapsResolvedWithinTolerance) {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), r01(0.0f, 1.0f);
+  uint32_t escapes = 0, particles = 0;
+  for (int scene = 0; scene < 20; ++scene) {
+    std::vector<Ellipsoid> es;
+    for (int k = 0; k < 12; ++k) {
+      const Quat q(Eigen::Vector4f(u(rng), u(rng), u(rng), u(rng)).normalized());
+      es.push_back(makeEllipsoid(Vec3(u(rng), u(rng), u(rng)) * 0.08f,
+                                 Vec3(0.02f + 0.08f * r01(rng), 0.02f + 0.08f * r01(rng), 0.01f + 0.05f * r01(rng)),
+                                 q.toRotationMatrix()));
+    }
+    EllipsoidCollider col;
+    col.setEllipsoids(es.data(), es.data(), static_cast<int>(es.size()));
+    for (int response = 0; response < 2; ++response) {
+      std::vector<Vec4> x;
+      for (int i = 0; i < 2000; ++i) x.emplace_back(u(rng) * 0.15f, u(rng) * 0.15f, u(rng) * 0.15f, 1.0f);
+      std::vector<Vec4> prev = x;
+      CollisionParams p;
+      p.response = static_cast<ContactResponse>(response);
+      const CollisionStats st = col.collide(x.data(), prev.data(), x.size(), p);
+      escapes += st.escapes;
+      particles += static_cast<uint32_t>(x.size());
+      EXPECT_LE(maxDepth(col, x), EllipsoidCollider::kPenetrationTolerance);
+    }
+  }
+  std::printf("[ overlaps ] 12 overlapping ellipsoids x 20 scenes: %u of %u particles needed the escape step\n",
+              escapes, particles);
+}
+
+// A large flat ellipsoid tilted by alpha is locally a plane: Coulomb's law says a resting
+// particle stays iff tan(alpha) < mu_s.
+float slideDistance(float alpha, ContactResponse response, float mu_s, float mu_k) {
+  const Mat3 R = Eigen::AngleAxisf(alpha, Vec3::UnitZ()).toRotationMatrix();
+  const Ellipsoid plane = makeEllipsoid(Vec3(0, 0, 0), Vec3(4.0f, 0.4f, 4.0f), R);
+  EllipsoidCollider col;
+  col.setEllipsoids(&plane, &plane, 1);
+  const Vec3 start = plane.centre + R * Vec3(0.0f, 0.4f + col.margin(), 0.0f);
+  Particles ps;
+  ps.add(start);
+  CollisionParams p;
+  p.response = response;
+  p.static_friction = mu_s;
+  p.kinetic_friction = mu_k;
+  const float dt = 1.0f / 240.0f;
+  for (int s = 0; s < 240; ++s) ps.step(col, Vec3(0.0f, -9.81f, 0.0f), dt, p);
+  return (ps.x[0].head<3>() - start).norm();
+}
+
+TEST(Collider, FrictionHoldsBelowFrictionAngleSlidesAbove) {
+  for (int response = 0; response < 2; ++response) {
+    const ContactResponse r = static_cast<ContactResponse>(response);
+    const float held = slideDistance(std::atan(0.5f), r, 0.6f, 0.4f);  // tan = 0.5 < 0.6
+    const float near = slideDistance(std::atan(0.58f), r, 0.6f, 0.4f);
+    const float slid = slideDistance(std::atan(0.7f), r, 0.6f, 0.4f);  // tan = 0.7 > 0.6
+    const float frictionless = slideDistance(std::atan(0.1f), r, 0.0f, 0.0f);
+    std::printf("[ friction ] %s: 1 s at 240 substeps on a slope, mu_s 0.6 mu_k 0.4: tan 0.50 -> %.3f mm, "
+                "tan 0.58 -> %.3f mm, tan 0.70 -> %.0f mm; frictionless tan 0.10 -> %.0f mm\n",
+                response ? "exact " : "radial", held * 1e3f, near * 1e3f, slid * 1e3f, frictionless * 1e3f);
+    EXPECT_LT(held, 1e-3f);
+    EXPECT_LT(near, 1e-3f);
+    // Kinetic: a = g (sin - mu_k cos) = 0.85 m/s^2 -> ~0.42 m in 1 s.
+    EXPECT_GT(slid, 0.3f);
+    EXPECT_GT(frictionless, 0.3f);
+  }
+}
+
+TEST(Collider, StaticFrictionCarriesRestingParticle) {
+  // A ball moving sideways at 0.3 m/s under a resting particle: friction accelerates it at up
+  // to mu_k g, then it rides along (static) — a sleeve does not slide off a moving arm.
+  const float dt = 1.0f / 240.0f, v = 0.3f, radius = 0.1f;
+  for (int response = 0; response < 2; ++response) {
+    for (float mu : {0.6f, 0.0f}) {
+      Particles ps;
+      EllipsoidCollider col;
+      CollisionParams p;
+      p.response = static_cast<ContactResponse>(response);
+      p.static_friction = mu;
+      p.kinetic_friction = mu * (0.4f / 0.6f);
+      ps.add(Vec3(0.0f, radius + col.margin(), 0.0f));
+      float x_half = 0.0f;
+      for (int s = 0; s < 240; ++s) {
+        const Ellipsoid a = makeEllipsoid(Vec3(v * static_cast<float>(s) * dt, 0, 0), Vec3::Constant(radius));
+        const Ellipsoid b = makeEllipsoid(Vec3(v * static_cast<float>(s + 1) * dt, 0, 0), Vec3::Constant(radius));
+        col.setEllipsoids(&a, &b, 1);
+        ps.step(col, Vec3(0.0f, -9.81f, 0.0f), dt, p);
+        if (s == 119) x_half = ps.x[0].x();
+      }
+      const Vec3 end = ps.x[0].head<3>();
+      std::printf("[ carry    ] %s mu_s %.1f: ball moved 300 mm, particle %.1f mm (last 0.5 s: %.2f mm vs 150)\n",
+                  response ? "exact " : "radial", mu, end.x() * 1e3f, (end.x() - x_half) * 1e3f);
+      if (mu > 0.0f) {
+        EXPECT_NEAR(end.x() - x_half, 0.5f * v, 1e-3f);  // rides with the ball
+        EXPECT_GT(end.y(), radius * 0.95f);               // still on top
+      } else {
+        EXPECT_LT(end.x(), 0.15f);  // without friction the ball slides out from under it
+      }
+    }
+  }
+}
+
+// A forearm-sized ellipsoid swept at 7 m/s (along +z) through a resting particle, 30 fps x 4
+// substeps: 5.8 cm per substep, more than the 4 cm radius. Returns in how many of 20 phases
+// (the ellipsoid's offset at the first substep) the particle passes through the ellipsoid: its
+// path relative to the ellipsoid crosses the ellipsoid's middle plane well inside the
+// cross-section. Going round the side (a glancing hit deflects a free particle) is not tunnelling.
+int tunnelledPhases(bool continuous, ContactResponse response, float radius, float lateral,
+                    uint32_t* catches) {
+  const float dt = 1.0f / 120.0f, v = 7.0f;
+  int tunnelled = 0;
+  for (int phase = 0; phase < 20; ++phase) {
+    const float z0 = -0.4f + v * dt * static_cast<float>(phase) / 20.0f;
+    Particles ps;
+    ps.add(Vec3(lateral, 0.02f, 0.0f));
+    EllipsoidCollider col;
+    CollisionParams p;
+    p.continuous = continuous;
+    p.response = response;
+    const Vec3 radii(radius, 0.13f, radius);
+    bool through = false;
+    for (int s = 0; s < 14; ++s) {
+      const Ellipsoid a = makeEllipsoid(Vec3(0, 0, z0 + v * dt * static_cast<float>(s)), radii);
+      const Ellipsoid b = makeEllipsoid(Vec3(0, 0, z0 + v * dt * static_cast<float>(s + 1)), radii);
+      col.setEllipsoids(&a, &b, 1);
+      const Vec3 rel0 = ps.x[0].head<3>() - a.centre;
+      const CollisionStats st = ps.step(col, Vec3::Zero(), dt, p);
+      const Vec3 rel1 = ps.x[0].head<3>() - b.centre;
+      if (catches) *catches += st.swept_catches;
+      EXPECT_TRUE(ps.x[0].allFinite());
+      if (rel0.z() > 0.0f && rel1.z() <= 0.0f) {
+        const Vec3 at = rel0 + (rel0.z() / (rel0.z() - rel1.z())) * (rel1 - rel0);
+        const Vec3 r = radii + Vec3::Constant(col.margin());
+        // Through the inner three quarters of the cross-section (a chord between two points on
+        // the surface of a particle sliding round the side cuts slightly inside).
+        if (Vec3(at.x() / r.x(), at.y() / r.y(), 0.0f).norm() < 0.75f) through = true;
+      }
+    }
+    if (through) ++tunnelled;
+  }
+  return tunnelled;
+}
+
+TEST(Collider, ContinuousStopsTunnelling) {
+  for (int response = 0; response < 2; ++response) {
+    const ContactResponse r = static_cast<ContactResponse>(response);
+    for (float radius : {0.04f, 0.015f}) {
+      for (float lateral : {0.0f, 0.5f * radius}) {
+        uint32_t catches = 0;
+        const int with = tunnelledPhases(true, r, radius, lateral, &catches);
+        const int without = tunnelledPhases(false, r, radius, lateral, nullptr);
+        std::printf("[ sweep    ] %s radius %2.0f mm, particle %4.1f mm off axis, 7 m/s at 120 Hz: passed through in "
+                    "%2d/20 phases without the swept test, %d/20 with it (%u swept catches)\n",
+                    response ? "exact " : "radial", radius * 1e3f, lateral * 1e3f, without, with, catches);
+        EXPECT_EQ(with, 0);
+        EXPECT_GT(without, 0);
+        EXPECT_GT(catches, 0u);
+      }
+    }
+  }
+}
+
+// Pure translation: the unit-space path of a resting particle is exactly linear, so the swept
+// catch puts it where the surface met it. Head-on at 0.4 m per substep into a 5 cm ball: the
+// particle ends at the ball's front pole (the remaining motion is all normal, nothing to slide).
+TEST(Collider, SweptCatchIsExactForTranslation) {
+  const Ellipsoid a = makeEllipsoid(Vec3(0.0f, 0.0f, -0.2f), Vec3::Constant(0.05f));
+  const Ellipsoid b = makeEllipsoid(Vec3(0.0f, 0.0f, 0.2f), Vec3::Constant(0.05f));
+  EllipsoidCollider col;
+  col.setEllipsoids(&a, &b, 1);
+  for (int response = 0; response < 2; ++response) {
+    CollisionParams p;
+    p.response = static_cast<ContactResponse>(response);
+    p.static_friction = p.kinetic_friction = 0.0f;
+    std::vector<Vec4> x = {Vec4(0.0f, 0.0f, 0.0f, 1.0f)};
+    const std::vector<Vec4> prev = x;
+    const CollisionStats st = col.collide(x.data(), prev.data(), 1, p);
+    EXPECT_EQ(st.swept_catches, 1u);
+    EXPECT_NEAR((x[0].head<3>() - Vec3(0.0f, 0.0f, 0.2f + 0.05f + col.margin())).norm(), 0.0f, 1e-6f);
+  }
+}
+
+// Rotation: the unit-space path of a resting point is an arc, which the swept test replaces by
+// its chord (exact for translation, off by the sagitta |q| (1 - cos(phi/2)) for a rotation phi
+// per substep). A forearm swinging about the elbow at 40 rad/s (hand ~10 m/s, 0.33 rad per
+// substep at 120 Hz) through resting particles: none passes through it with the swept test.
+int swingThroughs(bool continuous, int* flung) {
+  const float dt = 1.0f / 120.0f, omega = 40.0f, half = 0.13f;
+  auto pose = [&](float phi) {
+    const Mat3 R = Eigen::AngleAxisf(phi, Vec3::UnitZ()).toRotationMatrix();
+    return makeEllipsoid(R * Vec3(0.0f, half, 0.0f), Vec3(0.04f, half, 0.04f), R);
+  };
+  Particles ps;
+  for (int i = 0; i < 12; ++i) {  // ahead of the bone (which starts along +y, turning to -x)
+    const float rho = 0.04f + 0.018f * static_cast<float>(i), ang = 0.5f + 0.1f * static_cast<float>(i % 4);
+    ps.add(Vec3(-rho * std::sin(ang), rho * std::cos(ang), 0.005f * static_cast<float>(i % 3)));
+  }
+  EllipsoidCollider col;
+  CollisionParams p;
+  p.continuous = continuous;
+  int throughs = 0;
+  std::vector<bool> counted(ps.x.size(), false);
+  for (int s = 0; s < 12; ++s) {
+    const float phi0 = omega * dt * static_cast<float>(s), phi1 = omega * dt * static_cast<float>(s + 1);
+    const Ellipsoid a = pose(phi0), b = pose(phi1);
+    col.setEllipsoids(&a, &b, 1);
+    std::vector<Vec3> before(ps.x.size());
+    for (size_t i = 0; i < ps.x.size(); ++i) before[i] = ps.x[i].head<3>();
+    ps.step(col, Vec3::Zero(), dt, p);
+    for (size_t i = 0; i < ps.x.size(); ++i) {
+      // Particle in the bone's frame (y along the bone from the elbow, -x = the way it swings)
+      // at the substep's start and end; a pass-through crosses x = 0 well inside the limb.
+      const Vec3 l0 = Eigen::AngleAxisf(-phi0, Vec3::UnitZ()).toRotationMatrix() * before[i];
+      const Vec3 l1 = Eigen::AngleAxisf(-phi1, Vec3::UnitZ()).toRotationMatrix() * ps.x[i].head<3>();
+      if (l0.x() < 0.0f && l1.x() >= 0.0f && !counted[i]) {
+        const Vec3 at = l0 + (l0.x() / (l0.x() - l1.x())) * (l1 - l0);
+        const float m = col.margin();
+        const Vec3 u((at.y() - half) / (half + m), at.z() / (0.04f + m), 0.0f);
+        if (u.norm() < 0.75f) {
+          counted[i] = true;
+          ++throughs;
+        }
+      }
+    }
+  }
+  if (flung) {
+    *flung = 0;
+    for (const Vec4& x : ps.x) *flung += x.head<2>().norm() > 2.0f * half + 0.05f;
+  }
+  return throughs;
+}
+
+TEST(Collider, SweptTestHandlesRotation) {
+  int flung = 0;
+  const int with = swingThroughs(true, &flung);
+  const int without = swingThroughs(false, nullptr);
+  std::printf("[ swing    ] forearm at 40 rad/s through 12 resting particles, 120 Hz: %d pass through without the "
+              "swept test, %d with it (%d flung off the hand end)\n", without, with, flung);
+  EXPECT_EQ(with, 0);
+  EXPECT_GT(without, 0);
+}
+
+// A body-like random scene: ellipsoids moving between start and end, particles scattered with
+// random motion. Broad phase on and off must agree bit for bit.
+struct Scene {
+  std::vector<Ellipsoid> start, end;
+  std::vector<Vec4> x, prev;
+};
+
+Scene randomScene(int ellipsoids, int particles, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), r01(0.0f, 1.0f);
+  Scene s;
+  for (int k = 0; k < ellipsoids; ++k) {
+    const Quat q(Eigen::Vector4f(u(rng), u(rng), u(rng), u(rng)).normalized());
+    const Vec3 c(0.6f * u(rng), 0.9f + 0.8f * u(rng), 0.15f * u(rng));
+    const Vec3 radii(0.02f + 0.1f * r01(rng), 0.02f + 0.2f * r01(rng), 0.02f + 0.1f * r01(rng));
+    s.start.push_back(makeEllipsoid(c, radii, q.toRotationMatrix()));
+    const Quat dq(Eigen::AngleAxisf(0.2f * u(rng), Vec3(u(rng), u(rng), u(rng)).normalized()));
+    s.end.push_back(makeEllipsoid(c + Vec3(u(rng), u(rng), u(rng)) * 0.03f, radii, (dq * q).toRotationMatrix()));
+  }
+  for (int i = 0; i < particles; ++i) {
+    const Vec3 p(0.8f * u(rng), 0.9f + 1.0f * u(rng), 0.25f * u(rng));
+    const float speed = r01(rng) < 0.1f ? 0.2f : 0.01f;  // a few fast ones for the swept test
+    const Vec3 p0 = p + Vec3(u(rng), u(rng), u(rng)) * speed;
+    s.x.emplace_back(p.x(), p.y(), p.z(), r01(rng) < 0.05f ? 0.0f : 1.0f);
+    s.prev.emplace_back(p0.x(), p0.y(), p0.z(), 1.0f);
+  }
+  return s;
+}
+
+TEST(Collider, BroadPhaseOnOffIdentical) {
+  for (int n : {40, 100, 130, 300}) {
+    const Scene s = randomScene(n, 5000, 100u + static_cast<unsigned>(n));
+    EllipsoidCollider col;
+    col.setEllipsoids(s.start.data(), s.end.data(), n);
+    for (int response = 0; response < 2; ++response) {
+      for (int cont = 0; cont < 2; ++cont) {
+        CollisionParams p;
+        p.response = static_cast<ContactResponse>(response);
+        p.continuous = cont != 0;
+        std::vector<Vec4> a = s.x, b = s.x;
+        p.broad_phase = true;
+        const CollisionStats sa = col.collide(a.data(), s.prev.data(), a.size(), p);
+        p.broad_phase = false;
+        const CollisionStats sb = col.collide(b.data(), s.prev.data(), b.size(), p);
+        SCOPED_TRACE(::testing::Message() << n << " ellipsoids, response " << response << " continuous " << cont);
+        EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec4)), 0);
+        EXPECT_EQ(sa.tests, sb.tests);
+        EXPECT_EQ(sa.contacts, sb.contacts);
+        EXPECT_EQ(sa.swept_catches, sb.swept_catches);
+        EXPECT_GT(sa.contacts, 100u);
+        if (cont) {
+          EXPECT_GT(sa.swept_catches, 0u);
+        }
+        EXPECT_LE(maxDepth(col, a), EllipsoidCollider::kPenetrationTolerance);
+      }
+    }
+  }
+}
+
+TEST(Collider, ParticlesAreIndependent) {
+  const Scene s = randomScene(40, 3000, 9);
+  EllipsoidCollider col;
+  col.setEllipsoids(s.start.data(), s.end.data(), 40);
+  CollisionParams p;
+  std::vector<Vec4> whole = s.x, parts = s.x;
+  col.collide(whole.data(), s.prev.data(), whole.size(), p);
+  for (size_t i = 0; i < parts.size(); i += 7) {
+    col.collide(parts.data() + i, s.prev.data() + i, std::min<size_t>(7, parts.size() - i), p);
+  }
+  EXPECT_EQ(std::memcmp(whole.data(), parts.data(), whole.size() * sizeof(Vec4)), 0);
+}
+
+TEST(Collider, PinnedParticlesNeverMove) {
+  const Scene s = randomScene(40, 3000, 31);
+  EllipsoidCollider col;
+  col.setEllipsoids(s.start.data(), s.end.data(), 40);
+  std::vector<Vec4> x = s.x;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (size_t i = 0; i < x.size(); i += 3) x[i].w() = (i % 2) ? 0.0f : (i % 5 ? -1.0f : nan);
+  const std::vector<Vec4> before = x;
+  CollisionParams p;
+  const CollisionStats st = col.collide(x.data(), s.prev.data(), x.size(), p);
+  EXPECT_GT(st.contacts, 0u);
+  for (size_t i = 0; i < x.size(); i += 3) {
+    EXPECT_EQ(std::memcmp(&x[i], &before[i], sizeof(Vec4)), 0) << i;
+  }
+}
+
+TEST(Collider, DegenerateInputsStayFinite) {
+  const Ellipsoid sphere = makeEllipsoid(Vec3(0.1f, 1.0f, 0.0f), Vec3::Constant(0.05f));
+  const Ellipsoid ell = makeEllipsoid(Vec3(-0.2f, 1.2f, 0.3f), Vec3(0.1f, 0.03f, 0.06f),
+                                      Eigen::AngleAxisf(0.4f, Vec3::UnitX()).toRotationMatrix());
+  for (const Ellipsoid& e : {sphere, ell}) {
+    EllipsoidCollider col;
+    col.setEllipsoids(&e, &e, 1);
+    for (int response = 0; response < 2; ++response) {
+      for (int cont = 0; cont < 2; ++cont) {
+        CollisionParams p;
+        p.response = static_cast<ContactResponse>(response);
+        p.continuous = cont != 0;
+        // Exactly at the centre, no motion.
+        std::vector<Vec4> x = {Vec4(e.centre.x(), e.centre.y(), e.centre.z(), 1.0f)};
+        std::vector<Vec4> prev = x;
+        const CollisionStats st = col.collide(x.data(), prev.data(), 1, p);
+        EXPECT_EQ(st.contacts, 1u);
+        ASSERT_TRUE(x[0].allFinite());
+        EXPECT_LE(depthInside(col.inflatedEnd(0), x[0].head<3>()), EllipsoidCollider::kPenetrationTolerance);
+        // Pushed out along the smallest axis: the nearest exit.
+        const float moved = (x[0].head<3>() - e.centre).norm();
+        EXPECT_NEAR(moved, e.radii.minCoeff() + col.margin(), 1e-5f);
+        // Resting exactly on the surface, no motion: nothing happens, nothing NaN.
+        const Vec3 on = e.fromUnit(Vec3(0.0f, 1.0f, 0.0f) * ((e.radii.y() + col.margin()) / e.radii.y()));
+        x = {Vec4(on.x(), on.y(), on.z(), 1.0f)};
+        prev = x;
+        col.collide(x.data(), prev.data(), 1, p);
+        ASSERT_TRUE(x[0].allFinite());
+        EXPECT_LT((x[0].head<3>() - on).norm(), 1e-5f);
+        // No previous positions at all.
+        x = {Vec4(e.centre.x(), e.centre.y(), e.centre.z(), 1.0f)};
+        col.collide(x.data(), nullptr, 1, p);
+        ASSERT_TRUE(x[0].allFinite());
+      }
+    }
+  }
+  // Non-finite particles are skipped and do not disturb the others; bad ellipsoids are ignored.
+  Ellipsoid bad = sphere;
+  bad.radii = Vec3(std::numeric_limits<float>::quiet_NaN(), 0.1f, 0.1f);
+  bad.refresh();
+  const Ellipsoid pair_start[2] = {bad, sphere}, pair_end[2] = {bad, sphere};
+  EllipsoidCollider col;
+  col.setEllipsoids(pair_start, pair_end, 2);
+  const float inf = std::numeric_limits<float>::infinity();
+  std::vector<Vec4> x = {Vec4(inf, 0, 0, 1), Vec4(0.1f, 1.0f, 0.0f, 1.0f)};
+  std::vector<Vec4> prev = {Vec4(0, 0, 0, 1), Vec4(std::numeric_limits<float>::quiet_NaN(), 0, 0, 1)};
+  col.collide(x.data(), prev.data(), 2, CollisionParams{});
+  EXPECT_EQ(x[0].x(), inf);
+  ASSERT_TRUE(x[1].allFinite());
+  EXPECT_LE(depthInside(col.inflatedEnd(1), x[1].head<3>()), EllipsoidCollider::kPenetrationTolerance);
+  // Zero radius and zero margin: clamped, still finite.
+  Ellipsoid flat = sphere;
+  flat.radii = Vec3(0.05f, 0.0f, 0.05f);
+  col.setEllipsoids(&flat, &flat, 1, 0.0f);
+  x = {Vec4(0.1f, 1.0f, 0.0f, 1.0f)};
+  col.collide(x.data(), x.data(), 1, CollisionParams{});
+  ASSERT_TRUE(x[0].allFinite());
+  // Nonsense parameters: NaN / infinite / negative friction, an unknown response value.
+  col.setEllipsoids(&sphere, &sphere, 1);
+  CollisionParams wild;
+  wild.static_friction = std::numeric_limits<float>::quiet_NaN();
+  wild.kinetic_friction = inf;
+  wild.response = static_cast<ContactResponse>(7);
+  x = {Vec4(0.1f, 1.0f, 0.0f, 1.0f), Vec4(0.1f, 1.03f, 0.0f, 1.0f)};
+  prev = {Vec4(0.1f, 1.0f, 0.0f, 1.0f), Vec4(0.12f, 1.06f, 0.0f, 1.0f)};
+  col.collide(x.data(), prev.data(), 2, wild);
+  ASSERT_TRUE(x[0].allFinite());
+  ASSERT_TRUE(x[1].allFinite());
+  EXPECT_LE(depthInside(col.inflatedEnd(0), x[1].head<3>()), EllipsoidCollider::kPenetrationTolerance);
+  wild.static_friction = -1.0f;
+  col.collide(x.data(), prev.data(), 2, wild);
+  ASSERT_TRUE(x[1].allFinite());
+  // Empty collider.
+  col.setEllipsoids(nullptr, nullptr, 0);
+  EXPECT_EQ(col.collide(x.data(), nullptr, 1, CollisionParams{}).tests, 0u);
+}
+
+}  // namespace
+}  // namespace drape
