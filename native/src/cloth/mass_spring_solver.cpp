@@ -1,0 +1,132 @@
+#include "cloth/mass_spring_solver.h"
+
+#include <cmath>
+#include <utility>
+
+namespace drape {
+namespace {
+using Vec4 = Eigen::Vector4f;
+}  // namespace
+
+MassSpringSolver::MassSpringSolver(GarmentTopology topology) : topology_(std::move(topology)) {
+  const size_t n = topology_.particleCount();
+  x_.resize(n);
+  v_.assign(n, Vec4::Zero());
+  f_.assign(n, Vec4::Zero());
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3& p = topology_.rest_positions[i];
+    x_[i] = Vec4(p.x(), p.y(), p.z(), topology_.inverse_mass[i]);
+  }
+  good_x_ = x_;
+  good_v_ = v_;
+  pin_start_.resize(topology_.pinned.size());
+  pin_target_.resize(topology_.pinned.size());
+  for (size_t k = 0; k < topology_.pinned.size(); ++k)
+    pin_target_[k] = topology_.rest_positions[topology_.pinned[k]];
+}
+
+bool MassSpringSolver::setParams(const MassSpringParams& p, std::string& error) {
+  if (!isFinite(p.gravity)) {
+    error = "gravity must be finite";
+    return false;
+  }
+  const float non_negative[] = {p.stretch_stiffness, p.shear_stiffness, p.bend_stiffness,
+                                p.spring_damping, p.damping};
+  for (float f : non_negative) {
+    if (!std::isfinite(f) || f < 0.0f) {
+      error = "stiffness and damping must be finite and not negative";
+      return false;
+    }
+  }
+  if (!std::isfinite(p.explosion_speed) || !(p.explosion_speed > 0.0f)) {
+    error = "explosion_speed must be positive and finite";
+    return false;
+  }
+  params_ = p;
+  return true;
+}
+
+bool MassSpringSolver::setPinTargets(const Vec3* targets, size_t count, std::string& error) {
+  if (count != pin_target_.size() || (count > 0 && targets == nullptr)) {
+    error = "expected " + std::to_string(pin_target_.size()) + " pin targets, got " +
+            std::to_string(count);
+    return false;
+  }
+  for (size_t k = 0; k < count; ++k) {
+    if (!isFinite(targets[k])) {
+      error = "pin target " + std::to_string(k) + " is not finite";
+      return false;
+    }
+  }
+  for (size_t k = 0; k < count; ++k) pin_target_[k] = targets[k];
+  return true;
+}
+
+void MassSpringSolver::addSprings(const DistanceConstraints& c, float k) {
+  if (k == 0.0f && params_.spring_damping == 0.0f) return;
+  const float cd = params_.spring_damping;
+  for (size_t s = 0; s < c.size(); ++s) {
+    const uint32_t a = c.a[s], b = c.b[s];
+    const Vec3 d = x_[a].head<3>() - x_[b].head<3>();
+    const float len = d.norm();
+    if (len <= 1e-9f) continue;
+    const Vec3 dir = d / len;
+    const float rel = (v_[a].head<3>() - v_[b].head<3>()).dot(dir);
+    const Vec3 force = (-k * (len - c.rest[s]) - cd * rel) * dir;
+    f_[a].head<3>() += force;
+    f_[b].head<3>() -= force;
+  }
+}
+
+bool MassSpringSolver::step(float dt, int substeps) {
+  if (!(dt > 0.0f) || !(dt <= 1.0f) || substeps < 1 || substeps > 100000) return false;
+  const size_t n = x_.size();
+  for (size_t i = 0; i < n; ++i) {
+    good_x_[i] = x_[i];
+    good_v_[i] = v_[i];
+  }
+  for (size_t k = 0; k < pin_start_.size(); ++k)
+    pin_start_[k] = x_[topology_.pinned[k]].head<3>();
+  const MassSpringParams& p = params_;
+  const float h = dt / static_cast<float>(substeps);
+  const float keep = std::exp(-p.damping * h);
+  const float inv_n = 1.0f / static_cast<float>(substeps);
+  for (int s = 0; s < substeps; ++s) {
+    for (size_t i = 0; i < n; ++i) f_[i].setZero();
+    addSprings(topology_.stretch, p.stretch_stiffness);
+    addSprings(topology_.shear, p.shear_stiffness);
+    addSprings(topology_.bend, p.bend_stiffness);
+    // Symplectic Euler: v += h a, x += h v (every particle independent).
+    for (size_t i = 0; i < n; ++i) {
+      const float w = x_[i].w();
+      if (w == 0.0f) continue;
+      const Vec3 v = (v_[i].head<3>() + h * (p.gravity + w * f_[i].head<3>())) * keep;
+      v_[i].head<3>() = v;
+      x_[i].head<3>() += h * v;
+    }
+    const float t = s + 1 == substeps ? 1.0f : static_cast<float>(s + 1) * inv_n;
+    for (size_t k = 0; k < pin_target_.size(); ++k) {
+      const uint32_t i = topology_.pinned[k];
+      const Vec3 at = pin_start_[k] + t * (pin_target_[k] - pin_start_[k]);
+      v_[i].head<3>() = (at - x_[i].head<3>()) / h;
+      x_[i].head<3>() = at;
+    }
+  }
+  const float limit2 = p.explosion_speed * p.explosion_speed;
+  bool exploded = false;
+  for (size_t i = 0; i < n && !exploded; ++i) {
+    const float s2 = v_[i].head<3>().squaredNorm();
+    exploded = !std::isfinite(s2) || !(s2 <= limit2) || !isFinite(Vec3(x_[i].head<3>()));
+  }
+  if (exploded) {
+    for (size_t i = 0; i < n; ++i) {
+      x_[i] = good_x_[i];
+      v_[i] = good_v_[i];
+    }
+    ++explosions_;
+    return false;
+  }
+  return true;
+}
+
+}  // namespace drape

@@ -1,0 +1,86 @@
+// Substepped XPBD cloth (Macklin et al. 2019, "Small Steps in Physics Simulation"): a frame is
+// split into n substeps of one constraint iteration each; the Lagrange multipliers start at zero
+// every substep, so none are stored. Constraint kinds and colouring: cloth/garment_topology.h.
+// Method, defaults and figures: docs/cloth-solver.md.
+//
+// Layout (ready for an OpenCL port): positions, previous positions and velocities are arrays of
+// Eigen::Vector4f, xyz in metres (velocities m/s), w = inverse mass (0 = pinned) in positions.
+// Each colour group of each constraint kind could run one work-item per constraint; here they run
+// in order, so the result is deterministic (bit-identical for identical input on one build).
+// step() allocates nothing. Nothing throws: bad arguments return false and change nothing.
+#pragma once
+
+#include "cloth/garment_topology.h"
+#include "proxies/collision.h"
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace drape {
+
+struct XpbdParams {
+  Vec3 gravity = Vec3(0.0f, -9.81f, 0.0f);  // m/s^2
+  // Compliance (inverse stiffness, m/N for these distance constraints); 0 = rigid.
+  float stretch_compliance = 0.0f;
+  float shear_compliance = 1e-6f;
+  float bend_compliance = 1e-3f;
+  float tether_compliance = 0.0f;
+  float tether_scale = 1.0f;      // a particle may not go farther than rest * scale from its anchor
+  float damping = 1.0f;           // 1/s, velocity scaled by exp(-damping * h) every substep
+  float drag = 0.0f;              // 1/s, dv/dt += drag * (wind - v)
+  Vec3 wind = Vec3::Zero();       // m/s
+  float max_speed = 20.0f;        // m/s, speed clamp after integration; <= 0: none
+  CollisionParams collision;      // used when a collider is set
+};
+
+class XpbdSolver {
+ public:
+  static constexpr int kDefaultSubsteps = 10;
+
+  // Copies the topology; particles start at rest at its rest positions, pin targets there.
+  explicit XpbdSolver(GarmentTopology topology);
+
+  // Rejects non-finite values, negative compliance/damping/drag, tether_scale < 1.
+  bool setParams(const XpbdParams& params, std::string& error);
+  const XpbdParams& params() const { return params_; }
+
+  // Targets of the pinned particles at the end of the next step, one per topology().pinned entry
+  // (same order). During step() pinned particles move linearly from where they are to the target
+  // across the substeps. Rejects a count mismatch or a non-finite target.
+  bool setPinTargets(const Vec3* targets, size_t count, std::string& error);
+
+  // Optional ellipsoid collision, called once per substep after the constraints with the
+  // substep's start positions as `previous`. The caller keeps the collider alive and sets its
+  // ellipsoids (they are not interpolated by this solver across substeps). nullptr: none.
+  void setCollider(const EllipsoidCollider* collider) { collider_ = collider; }
+
+  // Teleport: all particles to `positions` (particleCount() xyz), velocities zero, pin targets =
+  // the new pinned positions. Rejects a count mismatch or non-finite input.
+  bool reset(const Vec3* positions, size_t count, std::string& error);
+
+  // Advances dt seconds in `substeps` substeps. Rejects dt not in (0, 1] or substeps not in
+  // [1, 1000].
+  bool step(float dt, int substeps = kDefaultSubsteps);
+
+  const GarmentTopology& topology() const { return topology_; }
+  size_t particleCount() const { return x_.size(); }
+  const Eigen::Vector4f* positions() const { return x_.data(); }    // w = inverse mass
+  const Eigen::Vector4f* velocities() const { return v_.data(); }   // w = 0
+  // Collision statistics summed over the last step's substeps.
+  const CollisionStats& lastCollisionStats() const { return collision_stats_; }
+
+ private:
+  void substep(float h, float pin_t);  // pin_t: fraction of the step at the substep end
+  void project(const DistanceConstraints& c, float alpha_tilde);
+  void projectTethers(float alpha_tilde);
+
+  GarmentTopology topology_;
+  XpbdParams params_;
+  std::vector<Eigen::Vector4f> x_, prev_, v_;
+  std::vector<Vec3> pin_start_, pin_target_;
+  const EllipsoidCollider* collider_ = nullptr;
+  CollisionStats collision_stats_;
+};
+
+}  // namespace drape
