@@ -115,11 +115,13 @@ TEST(Fidelity, SmallerSphereIsTenPercentShort) {
   ASSERT_TRUE(bvh.build(m.positions, m.indices));
   const Ellipsoid e = sphere(kCentre, 0.9f * kR);
   const FidelityReport f = measureFidelity(m.positions, m.indices, &e, 1, bvh, 400);
-  const float expected_mm = 1000.0f * 0.1f * kR;  // 12 mm
-  EXPECT_NEAR(f.body_to_union_mean_mm, expected_mm, 1e-3f);
-  EXPECT_NEAR(f.body_to_union_p95_mm, expected_mm, 1e-3f);
+  const float expected_mm = 1000.0f * 0.1f * kR;  // 12 mm at the vertices
+  // Triangle centroids sit inside the sphere by at most the tessellation error.
+  const float tol = 1000.0f * sag + 1e-3f;
+  EXPECT_NEAR(f.body_to_union_mean_mm, expected_mm, tol);
+  EXPECT_NEAR(f.body_to_union_p95_mm, expected_mm, tol);
   EXPECT_NEAR(f.body_to_union_max_mm, expected_mm, 1e-3f);
-  EXPECT_NEAR(f.body_to_union_area_mean_mm, expected_mm, 1e-3f);
+  EXPECT_NEAR(f.body_to_union_area_mean_mm, expected_mm, tol);
   EXPECT_EQ(f.outside_fraction, 1.0f);
   // The union's surface lies 0.1 r inside the mesh: it sticks out nowhere, so union -> body
   // (which measures only where the union is outside the body) is 0; the gap is body -> union's.
@@ -286,8 +288,9 @@ TEST(Fidelity, RingEllipsoidsOnTheBodyAreFastAndClose) {
               f.body_to_union_area_mean_mm, 100.0f * f.outside_fraction, f.union_to_body_mean_mm,
               f.union_to_body_p95_mm, f.union_to_body_max_mm, f.union_to_body_area_mean_mm,
               f.union_samples, ms);
-  // Ring points lie on their own ellipsoid's equator: no ring vertex is outside.
-  EXPECT_LT(f.body_to_union_p95_mm, 1.0f);
+  // Ring points lie on their own ellipsoid's equator: no ring vertex is outside; the centroids
+  // half-way between rings and in the junction stitches are (this stand-in has no overlap).
+  EXPECT_LT(f.body_to_union_p95_mm, 10.0f);
   EXPECT_GT(f.union_samples, 1000);
   EXPECT_LT(f.union_to_body_mean_mm, 60.0f);
 }

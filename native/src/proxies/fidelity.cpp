@@ -236,24 +236,34 @@ FidelityReport measureFidelity(const std::vector<Vec3>& body_positions,
   }
   const size_t m = ell.size();
 
-  // ---- body -> union, per vertex ----
-  const size_t n = body_positions.size();
-  std::vector<float> vertex_area(n, 0.0f);
+  // ---- body -> union, on the body surface: every vertex and every triangle's centroid ----
+  // Vertices alone miss the middle of the straight segments between rings, exactly where a union
+  // of ellipsoids dips; centroids sample it. Each sample carries half its share of the area.
+  const size_t nv = body_positions.size();
+  std::vector<Vec3> samples(body_positions);
+  std::vector<float> vertex_area(nv, 0.0f);
+  samples.reserve(nv + body_indices.size() / 3);
+  std::vector<float> centroid_area;
+  centroid_area.reserve(body_indices.size() / 3);
   for (size_t t = 0; t + 2 < body_indices.size(); t += 3) {
     const uint32_t a = body_indices[t], b = body_indices[t + 1], c = body_indices[t + 2];
-    if (a >= n || b >= n || c >= n) continue;
+    if (a >= nv || b >= nv || c >= nv) continue;
     const float area = 0.5f * (body_positions[b] - body_positions[a])
                                   .cross(body_positions[c] - body_positions[a]).norm();
     if (!std::isfinite(area)) continue;
-    vertex_area[a] += area / 3.0f;
-    vertex_area[b] += area / 3.0f;
-    vertex_area[c] += area / 3.0f;
+    vertex_area[a] += area / 6.0f;
+    vertex_area[b] += area / 6.0f;
+    vertex_area[c] += area / 6.0f;
+    samples.push_back((body_positions[a] + body_positions[b] + body_positions[c]) / 3.0f);
+    centroid_area.push_back(area / 2.0f);
   }
+  vertex_area.insert(vertex_area.end(), centroid_area.begin(), centroid_area.end());
+  const size_t n = samples.size();
   std::vector<float> outside(n, 0.0f);
   std::vector<float> box_distance(m, 0.0f);
   int outside_count = 0;
   for (size_t v = 0; v < n; ++v) {
-    const Vec3& p = body_positions[v];
+    const Vec3& p = samples[v];
     bool inside = false;
     for (size_t j = 0; j < m && !inside; ++j)
       inside = inBox(p, ell[j].bounds_min, ell[j].bounds_max) && ell[j].implicit(p) < 0.0f;
@@ -283,7 +293,7 @@ FidelityReport measureFidelity(const std::vector<Vec3>& body_positions,
     report.body_to_union_max_mm = s.max;
     report.body_to_union_area_mean_mm = s.weighted_mean;
     report.outside_fraction = static_cast<float>(outside_count) / static_cast<float>(n);
-    report.body_vertices = static_cast<int>(n);
+    report.body_vertices = static_cast<int>(nv);
   }
 
   // ---- union -> body, Fibonacci samples on each ellipsoid's exposed surface ----

@@ -41,7 +41,7 @@ struct FidelityReport {
   // body -> union, per body vertex (0 when inside any ellipsoid); mm. +inf with no ellipsoids.
   float body_to_union_mean_mm = 0.0f, body_to_union_p95_mm = 0.0f, body_to_union_max_mm = 0.0f;
   float body_to_union_area_mean_mm = 0.0f;  // each vertex weighted by 1/3 of its triangles' area
-  float outside_fraction = 0.0f;  // fraction of body vertices outside every ellipsoid by > 0.5 mm
+  float outside_fraction = 0.0f;  // fraction of body samples (vertices and triangle centroids) outside every ellipsoid by > 0.5 mm
   // union -> body: how far the union's surface samples lie outside the body mesh (0 where they
   // are inside it: those are gaps, measured by body -> union); mm.
   float union_to_body_mean_mm = 0.0f, union_to_body_p95_mm = 0.0f, union_to_body_max_mm = 0.0f;

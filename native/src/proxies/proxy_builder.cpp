@@ -9,11 +9,13 @@ namespace {
 
 // Drape rule: an ellipsoid per ring reaching kOverlap x the ring spacing along the chain. Between
 // two rings d apart, each ellipsoid's cross-section at d/2 is sqrt(1 - 1/(4 kOverlap^2)) of its
-// ring (0.943 for 1.5); scaling the cross-section by 2 / (1 + that) balances the bulge at the
-// ring against the dip half-way (+-2.9 % of the radius).
-constexpr float kOverlap = 1.5f;
+// ring (0.968 for 2); the cross-section is scaled so that half-way it still reaches 0.995 of the
+// ring, just outside the body mesh's straight segment there (a K-gon's chord sits at cos(pi/K)),
+// at the cost of a 2.8 % bulge at the ring itself. Measured against the 1.5 reach and a
+// balanced +-2.9 % scale in docs/proxies.md.
+constexpr float kOverlap = 2.0f;
 const float kMidFactor = std::sqrt(1.0f - 1.0f / (4.0f * kOverlap * kOverlap));
-const float kSectionScale = 2.0f / (1.0f + kMidFactor);
+const float kSectionScale = 0.995f / kMidFactor;
 // Sub-rings keep ellipsoids no further apart than this times the local radius, which bounds how
 // far an ellipsoid reaches past a bend or a chain end.
 constexpr float kMaxSpacingOverRadius = 1.0f;
