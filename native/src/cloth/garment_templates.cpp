@@ -1,0 +1,556 @@
+// Procedural garment templates (garment_templates.h). Method: docs/cloth-solver.md,
+// "Garment templates". Topology follows body/body_topology.cpp: tubes of equal rings stitched
+// quad by quad, the shoulder yoke as front and back strips from the armpit ring to the neck-base
+// ring, each armhole loop zipped to its sleeve's first ring, and for trousers the hip ring split
+// in two halves closed by a crotch bridge. Ring point j sits at angle 2 pi j / K from the frame's
+// x (forward) towards its z; for rings L -> U along a chain, (L_j, U_j, L_j+1) faces outwards.
+#include "cloth/garment_templates.h"
+
+#include "body/body_shape.h"
+#include "proxies/collision.h"
+#include "proxies/proxy_builder.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+
+namespace drape {
+
+namespace {
+
+using Loop = std::vector<uint32_t>;
+
+struct Sec {
+  Vec3 c = Vec3::Zero();
+  Mat3 f = Mat3::Identity();
+  float a = 0.0f, b = 0.0f;  // semi-axes along the frame's x and z (ease included)
+};
+
+Mat3 orthoFrame(const Vec3& x0, const Vec3& y0) {
+  const Vec3 y = y0.normalized();
+  Vec3 x = x0 - x0.dot(y) * y;
+  x = x.norm() > 1e-6f ? Vec3(x.normalized()) : anyPerpendicular(y);
+  Mat3 m;
+  m.col(0) = x;
+  m.col(1) = y;
+  m.col(2) = x.cross(y);
+  return m;
+}
+
+Sec lerpSec(const Sec& s0, const Sec& s1, float t) {
+  Sec s;
+  s.c = (1.0f - t) * s0.c + t * s1.c;
+  s.f = orthoFrame((1.0f - t) * s0.f.col(0) + t * s1.f.col(0), (1.0f - t) * s0.f.col(1) + t * s1.f.col(1));
+  s.a = (1.0f - t) * s0.a + t * s1.a;
+  s.b = (1.0f - t) * s0.b + t * s1.b;
+  return s;
+}
+
+Sec ringSec(const RingPose& r, float ease) {
+  Sec s;
+  s.c = r.centre;
+  s.f = r.frame;
+  s.a = r.forward_m + ease;
+  s.b = r.side_m + ease;
+  return s;
+}
+
+// The section of a chain at station parameter u (clamped to the chain's rings), ease added.
+Sec chainSec(const BodyModel& body, Chain c, float u, float ease) {
+  const int first = body.chainFirstRing(c), n = body.chainRingCount(c);
+  const auto& st = body.stations();
+  const auto& rings = body.rings();
+  if (u <= st[first].u) return ringSec(rings[first], ease);
+  for (int i = 0; i + 1 < n; ++i) {
+    const float u0 = st[first + i].u, u1 = st[first + i + 1].u;
+    if (u >= u0 && u <= u1 && u1 > u0) {
+      return lerpSec(ringSec(rings[first + i], ease), ringSec(rings[first + i + 1], ease), (u - u0) / (u1 - u0));
+    }
+  }
+  return ringSec(rings[first + n - 1], ease);
+}
+
+// The chain's ring whose station u is nearest `u`.
+int nearestRing(const BodyModel& body, Chain c, float u) {
+  const int first = body.chainFirstRing(c), n = body.chainRingCount(c);
+  int best = first;
+  for (int i = 0; i < n; ++i) {
+    if (std::fabs(body.stations()[first + i].u - u) < std::fabs(body.stations()[best].u - u)) best = first + i;
+  }
+  return best;
+}
+
+Vec3 secPoint(const Sec& s, int j, int K) {
+  const float th = 2.0f * kPi * static_cast<float>(j) / static_cast<float>(K);
+  return s.c + std::cos(th) * s.a * s.f.col(0) + std::sin(th) * s.b * s.f.col(2);
+}
+
+float secPerimeter(const Sec& s) {  // Ramanujan
+  const float a = s.a, b = s.b;
+  return kPi * (3.0f * (a + b) - std::sqrt((3.0f * a + b) * (a + 3.0f * b)));
+}
+
+int roundTo(float v, int multiple, int minimum) {
+  const int k = static_cast<int>(std::lround(v / static_cast<float>(multiple))) * multiple;
+  return std::max(minimum, k);
+}
+
+// Sections along a path s in [0, 1], evenly spaced in arc length by about h (at least 2).
+std::vector<Sec> samplePath(const std::function<Sec(float)>& path, float h) {
+  constexpr int kFine = 128;
+  std::vector<float> cum(kFine + 1, 0.0f);
+  Vec3 prev = path(0.0f).c;
+  for (int i = 1; i <= kFine; ++i) {
+    const Vec3 c = path(static_cast<float>(i) / kFine).c;
+    cum[i] = cum[i - 1] + (c - prev).norm();
+    prev = c;
+  }
+  const float L = cum[kFine];
+  const int rings = std::max(2, static_cast<int>(std::lround(L / h)) + 1);
+  std::vector<Sec> out;
+  for (int r = 0; r < rings; ++r) {
+    const float target = L * static_cast<float>(r) / static_cast<float>(rings - 1);
+    int i = 0;
+    while (i < kFine - 1 && cum[i + 1] < target) ++i;
+    const float seg = cum[i + 1] - cum[i];
+    const float t = seg > 0.0f ? std::clamp((target - cum[i]) / seg, 0.0f, 1.0f) : 0.0f;
+    out.push_back(path((static_cast<float>(i) + t) / kFine));
+  }
+  return out;
+}
+
+void stitchEqual(const uint32_t* L, const uint32_t* U, int n, bool closed, std::vector<uint32_t>& out) {
+  const int segments = closed ? n : n - 1;
+  for (int j = 0; j < segments; ++j) {
+    const int j1 = (j + 1) % n;
+    out.insert(out.end(), {L[j], U[j], L[j1]});
+    out.insert(out.end(), {L[j1], U[j], U[j1]});
+  }
+}
+
+// Closed loops of different sizes zipped together (as body_topology.cpp).
+void stitchLoops(const Loop& L, Loop U, const std::vector<Vec3>& x, std::vector<uint32_t>& out) {
+  const int n = static_cast<int>(L.size()), m = static_cast<int>(U.size());
+  int best = 0;
+  float bestCost = std::numeric_limits<float>::max();
+  for (int o = 0; o < m; ++o) {
+    float cost = 0.0f;
+    for (int i = 0; i < n; ++i) {
+      const int j = (o + static_cast<int>(std::lround(static_cast<double>(i) * m / n))) % m;
+      cost += (x[L[i]] - x[U[j]]).squaredNorm();
+    }
+    if (cost < bestCost) {
+      bestCost = cost;
+      best = o;
+    }
+  }
+  std::rotate(U.begin(), U.begin() + best, U.end());
+  int i = 0, j = 0;
+  while (i < n || j < m) {
+    const bool advanceL = j == m || (i < n && static_cast<long>(i + 1) * m <= static_cast<long>(j + 1) * n);
+    if (advanceL) {
+      out.insert(out.end(), {L[i % n], U[j % m], L[(i + 1) % n]});
+      ++i;
+    } else {
+      out.insert(out.end(), {L[i % n], U[j % m], U[(j + 1) % m]});
+      ++j;
+    }
+  }
+}
+
+class Builder {
+ public:
+  Builder(const BodyModel& body, const GarmentTemplateParams& p, const std::vector<Ellipsoid>& ell,
+          const std::vector<ProxySource>& src)
+      : body_(body), p_(p), ell_(ell), src_(src) {
+    hip_ = chainSec(body, Chain::Torso, 0.0f, p.ease_m);
+    // Knee drop below the hip ring, along the hip ring's axis.
+    const Sec knee = chainSec(body, Chain::LegL, 1.0f, 0.0f);
+    kneeDrop_ = std::max(0.1f, (hip_.c - knee.c).dot(hip_.f.col(1)));
+    buildEnclosure();
+  }
+
+  void build(float h, GarmentMesh& m) {
+    m = GarmentMesh{};
+    switch (p_.kind) {
+      case GarmentKind::TShirt: upper(h, 0.05f * p_.length_scale, false, 0.5f * p_.length_scale, m); break;
+      case GarmentKind::LongSleeve: upper(h, 0.05f * p_.length_scale, false, std::min(2.0f, 1.9f * p_.length_scale), m); break;
+      case GarmentKind::Dress: upper(h, 0.9f * kneeDrop_ * p_.length_scale, true, 0.35f * p_.length_scale, m); break;
+      case GarmentKind::Skirt: skirt(h, m); break;
+      case GarmentKind::Trousers: trousers(h, m); break;
+    }
+  }
+
+  // Moves every particle outside every ellipsoid inflated by `clear`, along the ellipsoid's
+  // normal (Newton steps on the implicit), which keeps neighbours apart (a radial projection
+  // from the centre would squeeze them together).
+  void pushOut(GarmentMesh& m, float clear) const {
+    for (int pass = 0; pass < 16; ++pass) {
+      bool moved = false;
+      for (Vec3& x : m.positions) {
+        for (const Ellipsoid& e : ell_) {
+          const Vec3 r = e.radii + Vec3::Constant(clear);
+          const Mat3 toUnit = r.cwiseInverse().asDiagonal() * e.rotation.transpose();
+          for (int it = 0; it < 20; ++it) {
+            const Vec3 q = toUnit * (x - e.centre);
+            const float f = q.squaredNorm() - 1.001f;
+            if (f >= 0.0f) break;
+            const Vec3 g = 2.0f * (toUnit.transpose() * q);
+            const float g2 = g.squaredNorm();
+            if (g2 < 1e-12f) {
+              x += e.rotation.col(0) * 1e-3f;
+              continue;
+            }
+            x -= (f - 1e-4f) / g2 * g;
+            moved = true;
+          }
+        }
+      }
+      if (!moved) return;
+    }
+    // Trapped between overlapping ellipsoids (e.g. the crotch between the thighs): slide down
+    // the hip axis until outside all of them.
+    const Vec3 down = -hip_.f.col(1);
+    for (Vec3& x : m.positions) {
+      for (int step = 0; step < 100 && insideAny(x, clear); ++step) x += 0.002f * down;
+    }
+  }
+
+  bool insideAny(const Vec3& x, float clear) const {
+    for (const Ellipsoid& e : ell_) {
+      const Vec3 r = e.radii + Vec3::Constant(clear);
+      const Vec3 q = (r.cwiseInverse().asDiagonal() * e.rotation.transpose()) * (x - e.centre);
+      if (q.squaredNorm() < 1.0f) return true;
+    }
+    return false;
+  }
+
+  void finishPins(GarmentMesh& m) const {
+    m.pin_local.clear();
+    for (size_t i = 0; i < m.pinned.size(); ++i) {
+      const RingPose& r = body_.rings()[static_cast<size_t>(m.pin_ring[i])];
+      m.pin_local.push_back(r.frame.transpose() * (m.positions[m.pinned[i]] - r.centre));
+    }
+  }
+
+ private:
+  uint32_t add(GarmentMesh& m, const Vec3& x) {
+    m.positions.push_back(x);
+    return static_cast<uint32_t>(m.positions.size() - 1);
+  }
+  Loop addRing(GarmentMesh& m, const Sec& s, int K) {
+    Loop l(static_cast<size_t>(K));
+    for (int j = 0; j < K; ++j) l[static_cast<size_t>(j)] = add(m, secPoint(s, j, K));
+    return l;
+  }
+  // A tube through the sections (in chain order); returns its rings.
+  std::vector<Loop> tube(GarmentMesh& m, const std::vector<Sec>& secs, int K) {
+    std::vector<Loop> rings;
+    for (const Sec& s : secs) {
+      rings.push_back(addRing(m, s, K));
+      if (rings.size() > 1) {
+        stitchEqual(rings[rings.size() - 2].data(), rings.back().data(), K, true, m.indices);
+      }
+    }
+    return rings;
+  }
+  void pinLoop(GarmentMesh& m, const Loop& l, int ring) {
+    for (uint32_t v : l) {
+      m.pinned.push_back(v);
+      m.pin_ring.push_back(ring);
+    }
+  }
+
+  // Required scale of the hip section (ease included) at drop d so that it encloses the legs
+  // and torso ellipsoids (grown by the ease) in a band around d; A-line flare and running max.
+  void buildEnclosure() {
+    constexpr float kStep = 0.01f, kBand = 0.03f;
+    const int n = static_cast<int>(std::ceil(1.6f * kneeDrop_ / kStep)) + 2;
+    std::vector<float> need(static_cast<size_t>(n), 1.0f);
+    const Vec3 X = hip_.f.col(0), Y = hip_.f.col(1), Z = hip_.f.col(2);
+    for (size_t k = 0; k < ell_.size(); ++k) {
+      // Only what a skirt must hang around: torso and legs (not the hands beside the hips).
+      const Chain c = k < src_.size() ? src_[k].chain : Chain::Torso;
+      if (c != Chain::Torso && c != Chain::LegL && c != Chain::LegR) continue;
+      const Ellipsoid& e = ell_[k];
+      const Vec3 r = e.radii + Vec3::Constant(p_.ease_m);
+      for (int a = 0; a <= 12; ++a) {
+        const float phi = kPi * static_cast<float>(a) / 12.0f;
+        for (int b = 0; b < 24; ++b) {
+          const float th = 2.0f * kPi * static_cast<float>(b) / 24.0f;
+          const Vec3 q(std::sin(phi) * std::cos(th), std::cos(phi), std::sin(phi) * std::sin(th));
+          const Vec3 x = e.centre + e.rotation * r.cwiseProduct(q) - hip_.c;
+          const float drop = -x.dot(Y);
+          if (drop < -kBand) continue;
+          const float s = std::sqrt(sq(x.dot(X) / hip_.a) + sq(x.dot(Z) / hip_.b));
+          const int lo = std::max(0, static_cast<int>(std::floor((drop - kBand) / kStep)));
+          const int hi = std::min(n - 1, static_cast<int>(std::ceil((drop + kBand) / kStep)));
+          for (int i = lo; i <= hi; ++i) need[static_cast<size_t>(i)] = std::max(need[static_cast<size_t>(i)], s);
+        }
+      }
+    }
+    scale_.assign(static_cast<size_t>(n), 1.0f);
+    float run = 1.0f;
+    for (int i = 0; i < n; ++i) {
+      run = std::max(run, need[static_cast<size_t>(i)]);
+      scale_[static_cast<size_t>(i)] = run;
+    }
+  }
+  static float sq(float v) { return v * v; }
+
+  // Hip section moved down by `drop` (>= 0); A-line (enclosing, flared) when `aline`.
+  Sec below(float drop, bool aline) const {
+    Sec s = hip_;
+    s.c = hip_.c - drop * hip_.f.col(1);
+    if (aline) {
+      const float fi = drop / 0.01f;
+      const int i = std::clamp(static_cast<int>(fi), 0, static_cast<int>(scale_.size()) - 1);
+      const float k = scale_[static_cast<size_t>(i)] * (1.0f + 0.25f * drop);
+      s.a *= k;
+      s.b *= k;
+    }
+    return s;
+  }
+
+  // Torso tube (hem below the hip -> armpit ring T), yoke strips to the neck base ring N,
+  // sleeves to arm station `sleeveU`. Pins: collar ring, shoulder-seam tops (and waist for dresses).
+  void upper(float h, float hemDrop, bool aline, float sleeveU, GarmentMesh& m) {
+    const float e = p_.ease_m;
+    const int torsoN = body_.chainRingCount(Chain::Torso);
+    const int ringT = body_.chainFirstRing(Chain::Torso) + torsoN - 1;
+    const float uTop = body_.stations()[static_cast<size_t>(ringT)].u;
+    const Sec T = chainSec(body_, Chain::Torso, uTop, e);
+    const int ringN = body_.chainFirstRing(Chain::Head);
+    const Sec N = ringSec(body_.rings()[static_cast<size_t>(ringN)], e);
+    const int K = roundTo(secPerimeter(T) / h, 8, 16);
+    // v in [0, 1]: first the part below the hip (by length), then the torso by station u.
+    const float below_len = hemDrop, above_len = (T.c - hip_.c).norm();
+    const float split = below_len / (below_len + above_len);
+    auto path = [&](float v) {
+      if (v < split) return below(hemDrop * (1.0f - v / split), aline);
+      return chainSec(body_, Chain::Torso, uTop * (v - split) / (1.0f - split), e);
+    };
+    const std::vector<Loop> torso = tube(m, samplePath(path, h), K);
+    const Loop& Tl = torso.back();
+    // Yoke rows between T and N (front and back arcs only).
+    const int hq = K / 8;
+    const float yokeLen = (N.c - T.c).norm() + 0.5f * (T.a - N.a);
+    const int R = std::max(1, static_cast<int>(std::lround(yokeLen / h)));
+    auto wrap = [K](int j) { return ((j % K) + K) % K; };
+    std::vector<std::vector<uint32_t>> rows(static_cast<size_t>(R + 1), std::vector<uint32_t>(static_cast<size_t>(K), UINT32_MAX));
+    for (int j = 0; j < K; ++j) rows[0][static_cast<size_t>(j)] = Tl[static_cast<size_t>(j)];
+    const Loop Nl = addRing(m, N, K);
+    for (int j = 0; j < K; ++j) rows[static_cast<size_t>(R)][static_cast<size_t>(j)] = Nl[static_cast<size_t>(j)];
+    auto inArc = [&](int j) {
+      const int a = wrap(j);
+      return a <= hq || a >= K - hq || std::abs(a - K / 2) <= hq;
+    };
+    for (int r = 1; r < R; ++r) {
+      const float t = static_cast<float>(r) / static_cast<float>(R);
+      for (int j = 0; j < K; ++j) {
+        if (!inArc(j)) continue;
+        const Vec3 pT = m.positions[Tl[static_cast<size_t>(j)]], pN = m.positions[Nl[static_cast<size_t>(j)]];
+        // Lerp, bulged outward a little (a shoulder is convex).
+        const Vec3 mid = (1.0f - t) * pT + t * pN;
+        const Sec s = lerpSec(T, N, t);
+        Vec3 out = mid - s.c;
+        out -= out.dot(s.f.col(1)) * s.f.col(1);
+        const float bulge = 0.15f * (T.a - N.a) * std::sin(kPi * t);
+        rows[static_cast<size_t>(r)][static_cast<size_t>(j)] =
+            add(m, mid + (out.norm() > 1e-6f ? Vec3(out.normalized() * bulge) : Vec3::Zero()));
+      }
+    }
+    auto arcOf = [&](int r, int from, int to) {
+      Loop a;
+      for (int j = from;; ++j) {
+        a.push_back(rows[static_cast<size_t>(r)][static_cast<size_t>(wrap(j))]);
+        if (wrap(j - to) == 0) break;
+      }
+      return a;
+    };
+    for (int r = 0; r < R; ++r) {
+      const Loop f0 = arcOf(r, -hq, hq), f1 = arcOf(r + 1, -hq, hq);
+      stitchEqual(f0.data(), f1.data(), static_cast<int>(f0.size()), false, m.indices);
+      const Loop b0 = arcOf(r, K / 2 - hq, K / 2 + hq), b1 = arcOf(r + 1, K / 2 - hq, K / 2 + hq);
+      stitchEqual(b0.data(), b1.data(), static_cast<int>(b0.size()), false, m.indices);
+    }
+    pinLoop(m, Nl, ringN);
+    // Sleeves.
+    for (bool left : {false, true}) {
+      const int from = left ? K / 2 + hq : hq, to = left ? K - hq : K / 2 - hq;
+      Loop loop = arcOf(0, from, to);
+      for (int r = 1; r < R; ++r) loop.push_back(rows[static_cast<size_t>(r)][static_cast<size_t>(wrap(to))]);
+      const Loop up = arcOf(R, from, to);
+      loop.insert(loop.end(), up.rbegin(), up.rend());
+      for (int r = R - 1; r >= 1; --r) loop.push_back(rows[static_cast<size_t>(r)][static_cast<size_t>(wrap(from))]);
+      const Chain arm = left ? Chain::ArmL : Chain::ArmR;
+      const Sec s0 = chainSec(body_, arm, 0.0f, e);
+      const int Ka = roundTo(secPerimeter(s0) / h, 4, 8);
+      auto apath = [&](float v) { return chainSec(body_, arm, v * sleeveU, e); };
+      const std::vector<Loop> sleeve = tube(m, samplePath(apath, h), Ka);
+      stitchLoops(loop, sleeve.front(), m.positions, m.indices);
+      // Shoulder-seam top: the sleeve's first-ring points highest along the torso's up axis.
+      const Vec3 up_axis = T.f.col(1);
+      std::vector<std::pair<float, uint32_t>> byHeight;
+      for (uint32_t v : sleeve.front()) byHeight.push_back({-m.positions[v].dot(up_axis), v});
+      std::sort(byHeight.begin(), byHeight.end());
+      const int count = std::max(1, Ka / 6);
+      for (int i = 0; i < count; ++i) {
+        m.pinned.push_back(byHeight[static_cast<size_t>(i)].second);
+        m.pin_ring.push_back(ringT);
+      }
+    }
+    if (aline) {
+      // Dress: also pin the ring nearest the waist station to the waist ring.
+      const int ringW = nearestRing(body_, Chain::Torso, 0.55f);
+      const Vec3 cw = body_.rings()[static_cast<size_t>(ringW)].centre;
+      size_t best = 0;
+      float bestD = std::numeric_limits<float>::max();
+      for (size_t i = 0; i < torso.size(); ++i) {
+        const float d = std::fabs((m.positions[torso[i][0]] - cw).dot(T.f.col(1)));
+        if (d < bestD) {
+          bestD = d;
+          best = i;
+        }
+      }
+      pinLoop(m, torso[best], ringW);
+    }
+  }
+
+  void skirt(float h, GarmentMesh& m) {
+    const float e = p_.ease_m;
+    const float hem = kneeDrop_ * p_.length_scale;
+    const float uW = body_.stations()[static_cast<size_t>(nearestRing(body_, Chain::Torso, 0.55f))].u;
+    const Sec W = chainSec(body_, Chain::Torso, uW, e);
+    const float above = (W.c - hip_.c).norm();
+    const float split = hem / (hem + above);
+    auto path = [&](float v) {
+      if (v < split) return below(hem * (1.0f - v / split), true);
+      return chainSec(body_, Chain::Torso, uW * (v - split) / (1.0f - split), e);
+    };
+    const float perim = 0.5f * (secPerimeter(W) + secPerimeter(below(hem, true)));
+    const int K = roundTo(perim / h, 8, 16);
+    const std::vector<Loop> rings = tube(m, samplePath(path, h), K);
+    pinLoop(m, rings.back(), nearestRing(body_, Chain::Torso, 0.55f));
+  }
+
+  void trousers(float h, GarmentMesh& m) {
+    const float e = p_.ease_m;
+    const int ringW = nearestRing(body_, Chain::Torso, 0.55f);
+    const float uW = body_.stations()[static_cast<size_t>(ringW)].u;
+    const int K = roundTo(secPerimeter(hip_) / h, 8, 16);
+    auto tpath = [&](float v) { return chainSec(body_, Chain::Torso, uW * v, e); };
+    const std::vector<Loop> torso = tube(m, samplePath(tpath, h), K);
+    pinLoop(m, torso.back(), ringW);
+    const Loop& P = torso.front();
+    // Crotch bridge from the hip ring's front centre to its back centre, sagging between the legs.
+    const Vec3 front = m.positions[P[0]], back = m.positions[P[static_cast<size_t>(K / 2)]];
+    const float drop = body_.stations()[static_cast<size_t>(body_.chainFirstRing(Chain::LegL))].offset_m + e;
+    const int nb = std::max(1, static_cast<int>(std::lround((back - front).norm() / h)) - 1);
+    Loop bridge;
+    for (int b = 0; b < nb; ++b) {
+      const float u = static_cast<float>(b + 1) / static_cast<float>(nb + 1);
+      bridge.push_back(add(m, front + u * (back - front) - hip_.f.col(1) * (drop * std::sqrt(std::sin(kPi * u)))));
+    }
+    const float uEnd = std::min(2.0f, 2.0f * p_.length_scale);
+    for (bool left : {false, true}) {
+      const Chain leg = left ? Chain::LegL : Chain::LegR;
+      const Sec s0 = chainSec(body_, leg, 0.0f, e);
+      const int Kl = roundTo(secPerimeter(s0) / h, 4, 8);
+      auto lpath = [&](float v) { return chainSec(body_, leg, v * uEnd, e); };
+      const std::vector<Loop> tubeRings = tube(m, samplePath(lpath, h), Kl);
+      Loop half;
+      if (!left) {
+        half.assign(P.begin(), P.begin() + K / 2 + 1);
+        half.insert(half.end(), bridge.rbegin(), bridge.rend());
+      } else {
+        half.assign(P.begin() + K / 2, P.end());
+        half.push_back(P[0]);
+        half.insert(half.end(), bridge.begin(), bridge.end());
+      }
+      std::reverse(half.begin(), half.end());
+      stitchLoops(half, tubeRings.front(), m.positions, m.indices);
+    }
+  }
+
+  const BodyModel& body_;
+  GarmentTemplateParams p_;
+  const std::vector<Ellipsoid>& ell_;
+  const std::vector<ProxySource>& src_;
+  Sec hip_;
+  float kneeDrop_ = 0.5f;
+  std::vector<float> scale_;
+};
+
+}  // namespace
+
+const char* garmentKindName(GarmentKind kind) {
+  switch (kind) {
+    case GarmentKind::TShirt: return "t-shirt";
+    case GarmentKind::LongSleeve: return "long-sleeve";
+    case GarmentKind::Skirt: return "skirt";
+    case GarmentKind::Dress: return "dress";
+    case GarmentKind::Trousers: return "trousers";
+  }
+  return "unknown";
+}
+
+bool makeGarmentTemplate(const BodyModel& body, const GarmentTemplateParams& p, GarmentMesh& out,
+                         std::string& err) {
+  const int kind = static_cast<int>(p.kind);
+  if (kind < 0 || kind > 4) {
+    err = "garment template: unknown garment kind";
+    return false;
+  }
+  if (p.target_particles < 200 || p.target_particles > 200000) {
+    err = "garment template: target_particles must be in [200, 200000]";
+    return false;
+  }
+  if (!std::isfinite(p.ease_m) || p.ease_m < 0.002f || p.ease_m > 0.1f) {
+    err = "garment template: ease_m must be in [0.002, 0.1] m";
+    return false;
+  }
+  if (!std::isfinite(p.length_scale) || p.length_scale < 0.5f || p.length_scale > 1.5f) {
+    err = "garment template: length_scale must be in [0.5, 1.5]";
+    return false;
+  }
+  for (Chain c : {Chain::Torso, Chain::Head, Chain::ArmL, Chain::ArmR, Chain::LegL, Chain::LegR}) {
+    if (body.chainRingCount(c) < 2) {
+      err = "garment template: body has too few rings";
+      return false;
+    }
+  }
+  for (const RingPose& r : body.rings()) {
+    if (!r.centre.allFinite() || !r.frame.allFinite() || !(r.forward_m > 0.0f) || !(r.side_m > 0.0f)) {
+      err = "garment template: body rings are not finite / not posed";
+      return false;
+    }
+  }
+  ProxyBuilder proxies(ProxyRule::Drape);
+  proxies.build(body, restPose(body.shape()));
+  Builder builder(body, p, proxies.ellipsoids(), proxies.sources());
+
+  // Resolution: spacing h adjusted until the particle count is within 4 % of the target.
+  const float target = static_cast<float>(p.target_particles);
+  float h = 0.03f;
+  GarmentMesh mesh;
+  for (int it = 0; it < 12; ++it) {
+    builder.build(h, mesh);
+    const float n = static_cast<float>(mesh.positions.size());
+    if (std::fabs(n - target) <= 0.04f * target) break;
+    h *= std::clamp(std::sqrt(n / target), 0.7f, 1.4f);
+  }
+  builder.pushOut(mesh, EllipsoidCollider::kDefaultMargin + 0.002f);
+  builder.finishPins(mesh);
+  for (const Vec3& x : mesh.positions) {
+    if (!x.allFinite()) {
+      err = "garment template: non-finite position";
+      return false;
+    }
+  }
+  out = std::move(mesh);
+  return true;
+}
+
+}  // namespace drape

@@ -1,0 +1,42 @@
+// Procedural garment templates sized to the body's shape: every garment is built from rings that
+// follow the body's own feature rings (body/body_model.h), each the body ring's ellipse grown by
+// an ease (clearance) in the same frame, so one template fits a thin and a heavy body alike.
+// Construction, resolution and attachments: docs/cloth-solver.md, "Garment templates".
+//
+// Never throws, never asserts: bad input returns false with a message and leaves `out` untouched.
+#pragma once
+
+#include "body/body_model.h"
+#include "common/math.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace drape {
+
+enum class GarmentKind : int { TShirt = 0, LongSleeve = 1, Skirt = 2, Dress = 3, Trousers = 4 };
+
+struct GarmentTemplateParams {
+  GarmentKind kind = GarmentKind::TShirt;
+  int target_particles = 2000;  // [200, 200000]; the result is within +-15 % (normally +-5 %)
+  float ease_m = 0.015f;        // clearance over the body, [0.002, 0.1] m
+  float length_scale = 1.0f;    // scales hem / sleeve / leg lengths, [0.5, 1.5]
+};
+
+struct GarmentMesh {
+  std::vector<Vec3> positions;     // rest/initial positions, metres, around the body's rest pose
+  std::vector<uint32_t> indices;   // triangles, counter-clockwise seen from outside
+  std::vector<uint32_t> pinned;    // attachment particles (waistband / collar + shoulder seam)
+  std::vector<int> pin_ring;       // for each pinned particle: the body ring it follows
+  std::vector<Vec3> pin_local;     // offset in that ring's frame: world = centre + frame * local
+};
+
+// body_in_rest_pose: a BodyModel updated with restPose(body.shape()) (the tracking ellipsoids of
+// that pose are what the template is pushed outside of).
+bool makeGarmentTemplate(const BodyModel& body_in_rest_pose, const GarmentTemplateParams& p,
+                         GarmentMesh& out, std::string& err);
+
+const char* garmentKindName(GarmentKind kind);
+
+}  // namespace drape
