@@ -38,18 +38,4 @@ bool isWatertight(const std::vector<uint32_t>& indices, uint32_t vertex_count) {
   return true;
 }
 
-double enclosedVolumeM3(const std::vector<drape_vec3>& positions, const std::vector<uint32_t>& indices) {
-  double six_v = 0.0;
-  const size_t n = positions.size();
-  for (size_t t = 0; t + 2 < indices.size(); t += 3) {
-    if (indices[t] >= n || indices[t + 1] >= n || indices[t + 2] >= n) continue;
-    const drape_vec3& a = positions[indices[t]];
-    const drape_vec3& b = positions[indices[t + 1]];
-    const drape_vec3& c = positions[indices[t + 2]];
-    const double bx = b.x, by = b.y, bz = b.z, cx = c.x, cy = c.y, cz = c.z;
-    six_v += a.x * (by * cz - bz * cy) + a.y * (bz * cx - bx * cz) + a.z * (bx * cy - by * cx);
-  }
-  return six_v / 6.0;
-}
-
 }  // namespace replay

@@ -1,4 +1,4 @@
-// Checks drape-replay runs on every body mesh it reads: finiteness, watertightness, volume.
+// Checks drape-replay runs on the body mesh it reads: finiteness and watertightness.
 #pragma once
 
 #include <drape/drape.h>
@@ -14,10 +14,5 @@ uint64_t countNonFinite(const std::vector<drape_vec3>& v);
 // True when the triangle list is closed: every index is below vertex_count, no triangle repeats a
 // vertex, and every undirected edge is shared by exactly two triangles.
 bool isWatertight(const std::vector<uint32_t>& indices, uint32_t vertex_count);
-
-// Enclosed volume in cubic metres by the divergence theorem: sum over triangles of
-// p0 . (p1 x p2) / 6, in double. Positive for a closed mesh wound counter-clockwise seen from
-// outside (as Drape's is).
-double enclosedVolumeM3(const std::vector<drape_vec3>& positions, const std::vector<uint32_t>& indices);
 
 }  // namespace replay

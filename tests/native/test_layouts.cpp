@@ -1,4 +1,5 @@
 // Sensor layouts <-> canonical skeleton (native/src/skeleton/layouts.h).
+#include "recording/recording.h"
 #include "skeleton/layouts.h"
 
 #include "test_data.h"
@@ -6,9 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
 #include <limits>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -40,41 +39,24 @@ const char* const kFrameLine =
     "-0.154176,-0.48576,2.54217,2,-0.196339,-0.428466,2.47433,2,0.133836,-0.438312,2.74992,2,"
     "0.158887,-0.391175,2.74938,2,";
 
-// Tiny local parser of the Kinect v2 CSV (no header, trailing comma, ticks + 25 x (X,Y,Z,state)).
-bool parseLine(const std::string& line, std::vector<JointSample>& out) {
-  std::vector<double> v;
-  std::stringstream ss(line);
-  std::string tok;
-  while (std::getline(ss, tok, ',')) {
-    if (tok.empty() || tok == "\r") continue;
-    v.push_back(std::stod(tok));
-  }
-  if (v.size() != 101) return false;
-  out.assign(25, JointSample{});
-  for (int j = 0; j < 25; ++j) {
-    const size_t b = 1 + 4 * static_cast<size_t>(j);
-    out[static_cast<size_t>(j)].position =
-        Vec3(static_cast<float>(v[b]), static_cast<float>(v[b + 1]), static_cast<float>(v[b + 2]));
-    out[static_cast<size_t>(j)].state = static_cast<TrackingState>(static_cast<int>(v[b + 3]));
-  }
-  return true;
-}
-
+// Frames of a Kinect v2 CSV, read by the project's reader.
 std::vector<std::vector<JointSample>> loadCsv(const std::string& path) {
   std::vector<std::vector<JointSample>> frames;
-  std::ifstream f(path);
-  std::string line;
-  std::vector<JointSample> fr;
-  while (std::getline(f, line)) {
-    if (parseLine(line, fr)) frames.push_back(fr);
+  Recording rec;
+  std::string err;
+  if (!readRecordingFile(path, static_cast<int>(Layout::Kinect2), rec, err)) {
+    ADD_FAILURE() << err;
+    return frames;
   }
+  for (const RecordingFrame& f : rec.frames) frames.push_back(f.joints);
   return frames;
 }
 
 std::vector<JointSample> embeddedFrame() {
-  std::vector<JointSample> f;
-  EXPECT_TRUE(parseLine(kFrameLine, f));
-  return f;
+  Recording rec;
+  std::string err;
+  EXPECT_TRUE(parseRecording(kFrameLine, static_cast<int>(Layout::Kinect2), rec, err)) << err;
+  return rec.frames.empty() ? std::vector<JointSample>{} : rec.frames[0].joints;
 }
 
 const char* const kRecordings[] = {

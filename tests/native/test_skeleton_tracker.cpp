@@ -1,5 +1,6 @@
 // SkeletonTracker (native/src/skeleton/tracker.h): smoothing, steady bone lengths, lost joints,
 // teleports - on the real Kinect v2 recordings and on synthetic skeletons.
+#include "recording/recording.h"
 #include "skeleton/tracker.h"
 
 #include "skeleton/layouts.h"
@@ -11,8 +12,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -20,41 +19,28 @@ namespace drape {
 namespace {
 
 // ------------------------------------------------------------------------------------------
-// Real recordings: a tiny local parser (the recording reader lives elsewhere).
+// Real recordings, read by the project's reader and mapped onto the canonical skeleton.
 
-struct Recording {
+struct Take {
   std::vector<double> t;                // seconds from the first frame
   std::vector<SkeletonPose> raw;        // canonical
   std::vector<std::vector<JointSample>> v2;  // as recorded
 };
 
-Recording loadKinect2Csv(const std::string& path) {
-  Recording r;
-  std::ifstream f(path);
-  std::string line;
-  double t0 = 0.0;
-  while (std::getline(f, line)) {
-    std::vector<double> v;
-    std::stringstream ss(line);
-    std::string tok;
-    while (std::getline(ss, tok, ',')) {
-      if (tok.empty() || tok == "\r") continue;
-      v.push_back(std::stod(tok));
-    }
-    if (v.size() != 101) continue;
-    if (r.t.empty()) t0 = v[0];
-    std::vector<JointSample> js(25);
-    for (size_t j = 0; j < 25; ++j) {
-      js[j].position = Vec3(static_cast<float>(v[1 + 4 * j]), static_cast<float>(v[2 + 4 * j]),
-                            static_cast<float>(v[3 + 4 * j]));
-      js[j].state = static_cast<TrackingState>(static_cast<int>(v[4 + 4 * j]));
-    }
+Take loadKinect2Csv(const std::string& path) {
+  Take r;
+  drape::Recording rec;
+  std::string err;
+  if (!readRecordingFile(path, static_cast<int>(Layout::Kinect2), rec, err)) {
+    ADD_FAILURE() << err;
+    return r;
+  }
+  for (const RecordingFrame& f : rec.frames) {
     SkeletonPose p;
-    std::string err;
-    if (!mapToCanonical(Layout::Kinect2, js.data(), 25, p, err)) continue;
-    r.t.push_back((v[0] - t0) * 1e-7);
+    if (!mapToCanonical(Layout::Kinect2, f.joints.data(), static_cast<int>(f.joints.size()), p, err)) continue;
+    r.t.push_back(f.time_s);
     r.raw.push_back(p);
-    r.v2.push_back(js);
+    r.v2.push_back(f.joints);
   }
   return r;
 }
@@ -66,7 +52,7 @@ const char* const kRecordings[] = {
     "kinect_v2_msft_labanotation/KinectReader_joints_closerange.csv",
 };
 
-std::vector<SkeletonPose> runTracker(SkeletonTracker& tr, const Recording& r) {
+std::vector<SkeletonPose> runTracker(SkeletonTracker& tr, const Take& r) {
   std::vector<SkeletonPose> out;
   out.reserve(r.raw.size());
   for (size_t i = 0; i < r.raw.size(); ++i) {
@@ -112,7 +98,7 @@ TEST(SkeletonTrackerRecording, BoneLengthsConstantAfterCalibration) {
   for (const char* rel : kRecordings) {
     DRAPE_REQUIRE_SHARED(path, rel);
     SCOPED_TRACE(rel);
-    const Recording r = loadKinect2Csv(path);
+    const Take r = loadKinect2Csv(path);
     ASSERT_GT(r.raw.size(), 100u);
     for (FilterKind kind : {FilterKind::OneEuro, FilterKind::DoubleExponential, FilterKind::None}) {
       TrackerParams p;
@@ -154,7 +140,7 @@ TEST(SkeletonTrackerRecording, StaysNearTheRawTrackedJoints) {
   for (const char* rel : kRecordings) {
     DRAPE_REQUIRE_SHARED(path, rel);
     SCOPED_TRACE(rel);
-    const Recording r = loadKinect2Csv(path);
+    const Take r = loadKinect2Csv(path);
     SkeletonTracker tr;
     const auto out = runTracker(tr, r);
     std::vector<double> err;
@@ -182,7 +168,7 @@ TEST(SkeletonTrackerRecording, StaysNearTheRawTrackedJoints) {
 // Kinect SDK defaults) on the wave-hand take; 8.8 / 10.3 on the balancing take.
 TEST(SkeletonTrackerRecording, JitterOfAStillJointReduced) {
   DRAPE_REQUIRE_SHARED(path, "kinect_v2_msft_labanotation/Ges01_wavehand.csv");
-  const Recording r = loadKinect2Csv(path);
+  const Take r = loadKinect2Csv(path);
   std::vector<SkeletonPose> raw = r.raw;
   const double rawAcc = accelerationRms(raw, r.t, idx(Joint::Pelvis), 30);
   ASSERT_GT(rawAcc, 0.5);
@@ -208,7 +194,7 @@ TEST(SkeletonTrackerRecording, JitterOfAStillJointReduced) {
 // Tracked parameters).
 TEST(SkeletonTrackerRecording, InferredJumpingLegsSmoothedHarder) {
   DRAPE_REQUIRE_SHARED(path, "kinect_v2_msft_labanotation/KinectReader_joints_closerange.csv");
-  const Recording r = loadKinect2Csv(path);
+  const Take r = loadKinect2Csv(path);
   SkeletonTracker tr;
   const auto out = runTracker(tr, r);
   double rawSum = 0.0, outSum = 0.0;
@@ -225,7 +211,7 @@ TEST(SkeletonTrackerRecording, OtherLayoutsNeverNaN) {
   for (const char* rel : kRecordings) {
     DRAPE_REQUIRE_SHARED(path, rel);
     SCOPED_TRACE(rel);
-    const Recording r = loadKinect2Csv(path);
+    const Take r = loadKinect2Csv(path);
     for (Layout layout : {Layout::Kinect1, Layout::Azure}) {
       SkeletonTracker tr;
       for (size_t i = 0; i < r.v2.size(); ++i) {

@@ -55,6 +55,9 @@ Vec3 safeNormalized(const Vec3& v, const Vec3& fallback) {
 
 }  // namespace
 
+int chainJointCount(Chain c) { return kChains[static_cast<int>(c)].count; }
+Joint chainJoint(Chain c, int k) { return kChains[static_cast<int>(c)].joints[k]; }
+
 const char* chainName(Chain c) {
   static const char* const kNames[kChainCount] = {"torso", "head", "arm_l", "arm_r", "leg_l", "leg_r"};
   const int i = static_cast<int>(c);

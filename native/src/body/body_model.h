@@ -21,6 +21,9 @@ namespace drape {
 enum class Chain : int { Torso = 0, Head, ArmL, ArmR, LegL, LegR, Count };
 constexpr int kChainCount = static_cast<int>(Chain::Count);
 const char* chainName(Chain c);
+// The joints a chain runs through: bone k of the chain is chainJoint(c, k) -> chainJoint(c, k+1).
+int chainJointCount(Chain c);
+Joint chainJoint(Chain c, int k);
 
 // Where a ring sits and how big it is. `u` runs along the chain: bone k of the chain covers
 // u in [k, k+1] (0 = the chain's first joint); `offset_m` slides the ring further along the

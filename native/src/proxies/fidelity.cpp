@@ -1,5 +1,7 @@
 #include "proxies/fidelity.h"
 
+#include "proxies/closest_point.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -7,147 +9,11 @@
 namespace drape {
 namespace {
 
-using Vec3d = Eigen::Vector3d;
-
-constexpr int kMaxBisections = 1100;  // > digits - min_exponent of double; never reached in practice
 constexpr float kInf = std::numeric_limits<float>::infinity();
 // A union sample is dropped when it lies deeper than this inside another ellipsoid, in that
 // ellipsoid's unit space (|q| < 1 - kStrictlyInside): about 0.1 mm for a 10 cm radius, so samples
 // on the seam where two surfaces cross are kept.
 constexpr float kStrictlyInside = 1e-3f;
-
-double robustLength(double a, double b) {
-  const double m = std::max(std::fabs(a), std::fabs(b));
-  if (m == 0.0) return 0.0;
-  const double x = a / m, y = b / m;
-  return m * std::sqrt(x * x + y * y);
-}
-
-double robustLength(double a, double b, double c) {
-  const double m = std::max(std::fabs(a), std::max(std::fabs(b), std::fabs(c)));
-  if (m == 0.0) return 0.0;
-  const double x = a / m, y = b / m, z = c / m;
-  return m * std::sqrt(x * x + y * y + z * z);
-}
-
-// Eberly: root of (r0 z0 / (s + r0))^2 + (z1 / (s + 1))^2 - 1 by bisection.
-double ellipseRoot(double r0, double z0, double z1, double g) {
-  const double n0 = r0 * z0;
-  double s0 = z1 - 1.0;
-  double s1 = g < 0.0 ? 0.0 : robustLength(n0, z1) - 1.0;
-  double s = 0.0;
-  for (int i = 0; i < kMaxBisections; ++i) {
-    s = 0.5 * (s0 + s1);
-    if (s == s0 || s == s1) break;
-    const double ratio0 = n0 / (s + r0), ratio1 = z1 / (s + 1.0);
-    g = ratio0 * ratio0 + ratio1 * ratio1 - 1.0;
-    if (g > 0.0) s0 = s;
-    else if (g < 0.0) s1 = s;
-    else break;
-  }
-  return s;
-}
-
-// Closest point on the ellipse (e0 >= e1 > 0) to (y0, y1), y >= 0, first quadrant.
-double distancePointEllipse(double e0, double e1, double y0, double y1, double& x0, double& x1) {
-  if (y1 > 0.0) {
-    if (y0 > 0.0) {
-      const double z0 = y0 / e0, z1 = y1 / e1;
-      const double g = z0 * z0 + z1 * z1 - 1.0;
-      if (g != 0.0) {
-        const double r0 = (e0 / e1) * (e0 / e1);
-        const double sbar = ellipseRoot(r0, z0, z1, g);
-        x0 = r0 * y0 / (sbar + r0);
-        x1 = y1 / (sbar + 1.0);
-        return std::sqrt((x0 - y0) * (x0 - y0) + (x1 - y1) * (x1 - y1));
-      }
-      x0 = y0;
-      x1 = y1;
-      return 0.0;
-    }
-    x0 = 0.0;
-    x1 = e1;
-    return std::fabs(y1 - e1);
-  }
-  const double numer0 = e0 * y0, denom0 = e0 * e0 - e1 * e1;
-  if (numer0 < denom0) {
-    const double xde0 = numer0 / denom0;
-    x0 = e0 * xde0;
-    x1 = e1 * std::sqrt(std::max(0.0, 1.0 - xde0 * xde0));
-    return std::sqrt((x0 - y0) * (x0 - y0) + x1 * x1);
-  }
-  x0 = e0;
-  x1 = 0.0;
-  return std::fabs(y0 - e0);
-}
-
-// Eberly: root of sum_i (r_i z_i / (s + r_i))^2 - 1 (r2 = 1) by bisection.
-double ellipsoidRoot(double r0, double r1, double z0, double z1, double z2, double g) {
-  const double n0 = r0 * z0, n1 = r1 * z1;
-  double s0 = z2 - 1.0;
-  double s1 = g < 0.0 ? 0.0 : robustLength(n0, n1, z2) - 1.0;
-  double s = 0.0;
-  for (int i = 0; i < kMaxBisections; ++i) {
-    s = 0.5 * (s0 + s1);
-    if (s == s0 || s == s1) break;
-    const double ratio0 = n0 / (s + r0), ratio1 = n1 / (s + r1), ratio2 = z2 / (s + 1.0);
-    g = ratio0 * ratio0 + ratio1 * ratio1 + ratio2 * ratio2 - 1.0;
-    if (g > 0.0) s0 = s;
-    else if (g < 0.0) s1 = s;
-    else break;
-  }
-  return s;
-}
-
-// Closest point on the ellipsoid (e0 >= e1 >= e2 > 0) to y >= 0, first octant.
-double distancePointEllipsoid(const double e[3], const double y[3], double x[3]) {
-  if (y[2] > 0.0) {
-    if (y[1] > 0.0) {
-      if (y[0] > 0.0) {
-        const double z0 = y[0] / e[0], z1 = y[1] / e[1], z2 = y[2] / e[2];
-        const double g = z0 * z0 + z1 * z1 + z2 * z2 - 1.0;
-        if (g != 0.0) {
-          const double r0 = (e[0] / e[2]) * (e[0] / e[2]), r1 = (e[1] / e[2]) * (e[1] / e[2]);
-          const double sbar = ellipsoidRoot(r0, r1, z0, z1, z2, g);
-          x[0] = r0 * y[0] / (sbar + r0);
-          x[1] = r1 * y[1] / (sbar + r1);
-          x[2] = y[2] / (sbar + 1.0);
-          return std::sqrt((x[0] - y[0]) * (x[0] - y[0]) + (x[1] - y[1]) * (x[1] - y[1]) +
-                           (x[2] - y[2]) * (x[2] - y[2]));
-        }
-        x[0] = y[0];
-        x[1] = y[1];
-        x[2] = y[2];
-        return 0.0;
-      }
-      x[0] = 0.0;
-      return distancePointEllipse(e[1], e[2], y[1], y[2], x[1], x[2]);
-    }
-    if (y[0] > 0.0) {
-      x[1] = 0.0;
-      return distancePointEllipse(e[0], e[2], y[0], y[2], x[0], x[2]);
-    }
-    x[0] = 0.0;
-    x[1] = 0.0;
-    x[2] = e[2];
-    return std::fabs(y[2] - e[2]);
-  }
-  // y2 == 0: an inside point may have its closest point off the plane.
-  const double denom0 = e[0] * e[0] - e[2] * e[2], denom1 = e[1] * e[1] - e[2] * e[2];
-  const double numer0 = e[0] * y[0], numer1 = e[1] * y[1];
-  if (numer0 < denom0 && numer1 < denom1) {
-    const double xde0 = numer0 / denom0, xde1 = numer1 / denom1;
-    const double discr = 1.0 - xde0 * xde0 - xde1 * xde1;
-    if (discr > 0.0) {
-      x[0] = e[0] * xde0;
-      x[1] = e[1] * xde1;
-      x[2] = e[2] * std::sqrt(discr);
-      return std::sqrt((x[0] - y[0]) * (x[0] - y[0]) + (x[1] - y[1]) * (x[1] - y[1]) + x[2] * x[2]);
-    }
-  }
-  x[2] = 0.0;
-  return distancePointEllipse(e[0], e[1], y[0], y[1], x[0], x[1]);
-}
 
 float boxDistance(const Vec3& p, const Vec3& lo, const Vec3& hi) {
   const Vec3 d = (lo - p).cwiseMax(p - hi).cwiseMax(0.0f);
@@ -198,29 +64,15 @@ Vec3 fibonacciSpherePoint(int i, int n) {
 
 EllipsoidSurfacePoint ellipsoidSurfacePoint(const Ellipsoid& el, const Vec3& p) {
   EllipsoidSurfacePoint out;
-  const Vec3d radii = el.radii.cast<double>();
-  const Vec3d d = p.cast<double>() - el.centre.cast<double>();
-  if (!(radii.minCoeff() > 0.0) || !std::isfinite(radii.sum()) || !std::isfinite(d.sum())) {
+  const Vec3 d = p - el.centre;
+  if (!(el.radii.minCoeff() > 0.0f) || !std::isfinite(el.radii.sum()) || !isFinite(d)) {
     out.point = el.centre;
-    out.distance = static_cast<float>(d.norm());
+    out.distance = d.norm();
     return out;
   }
-  const Eigen::Matrix3d rot = el.rotation.cast<double>();
-  const Vec3d local = rot.transpose() * d;
-  // Sort the axes by decreasing radius; solve in the first octant.
-  int order[3] = {0, 1, 2};
-  std::sort(order, order + 3, [&](int a, int b) { return radii[a] > radii[b]; });
-  double e[3], y[3], x[3];
-  for (int k = 0; k < 3; ++k) {
-    e[k] = radii[order[k]];
-    y[k] = std::fabs(local[order[k]]);
-  }
-  const double dist = distancePointEllipsoid(e, y, x);
-  Vec3d closest_local;
-  for (int k = 0; k < 3; ++k)
-    closest_local[order[k]] = local[order[k]] < 0.0 ? -x[k] : x[k];
-  out.point = (el.centre.cast<double>() + rot * closest_local).cast<float>();
-  out.distance = static_cast<float>(dist);
+  // The collider's reference solver (Eberly's bisection in double, proxies/closest_point.h).
+  const Vec3 closest_local = closestPointOnEllipsoid(el.radii, el.rotation.transpose() * d, &out.distance);
+  out.point = el.centre + el.rotation * closest_local;
   return out;
 }
 

@@ -18,12 +18,9 @@
 // per-sample statistics carry that bias; union_to_body_area_mean_mm weights each sample by its
 // area element (the weights sum to the union's area, up to sampling error).
 //
-// Distance from a body vertex outside an ellipsoid to the ellipsoid's surface: exact closest
-// point by Eberly's robust bisection ("Distance from a point to an ellipse, an ellipsoid, or a
-// hyperellipsoid", Geometric Tools, 2013) in double precision, bisecting the Lagrange
-// multiplier's secular equation until the interval stops shrinking (<= ~1 100 halvings, ~60 in
-// practice). Accurate to double rounding in the ellipsoid's frame; the float inputs and output
-// bound the error at ~1e-6 of the coordinates' magnitude (< 3 µm for a body 2.5 m from the sensor).
+// Distance from a body sample outside an ellipsoid to the ellipsoid's surface: the exact closest
+// point from closestPointOnEllipsoid (proxies/closest_point.h: Eberly's robust bisection in
+// double), in the ellipsoid's frame.
 // Ellipsoids whose bounding box is farther than the best distance so far are skipped, the nearest
 // box first. measureFidelity refreshes its own copies of the ellipsoids, so callers need not.
 #pragma once
@@ -63,7 +60,7 @@ FidelityReport measureFidelity(const std::vector<Vec3>& body_positions,
                                int samples_per_ellipsoid = 256);
 
 // Closest point on the ellipsoid's surface to p (inside or outside), and the unsigned distance.
-// Eberly's bisection in double, as above. Reads only centre, rotation and radii (no refresh()
+// closestPointOnEllipsoid (proxies/closest_point.h) in the ellipsoid frame. Reads only centre, rotation and radii (no refresh()
 // needed). Radii that are not all positive and finite give the centre and |p - centre|.
 struct EllipsoidSurfacePoint {
   Vec3 point = Vec3::Zero();

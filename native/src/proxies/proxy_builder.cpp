@@ -11,8 +11,8 @@ namespace {
 // two rings d apart, each ellipsoid's cross-section at d/2 is sqrt(1 - 1/(4 kOverlap^2)) of its
 // ring (0.968 for 2); the cross-section is scaled so that half-way it still reaches 0.995 of the
 // ring, just outside the body mesh's straight segment there (a K-gon's chord sits at cos(pi/K)),
-// at the cost of a 2.8 % bulge at the ring itself. Measured against the 1.5 reach and a
-// balanced +-2.9 % scale in docs/proxies.md.
+// at the cost of a 2.8 % bulge at the ring itself (docs/proxies.md says why 1.5 x with a balanced
+// +-2.9 % scale was not enough).
 constexpr float kOverlap = 2.0f;
 const float kMidFactor = std::sqrt(1.0f - 1.0f / (4.0f * kOverlap * kOverlap));
 const float kSectionScale = 0.995f / kMidFactor;
@@ -20,17 +20,6 @@ const float kSectionScale = 0.995f / kMidFactor;
 // far an ellipsoid reaches past a bend or a chain end.
 constexpr float kMaxSpacingOverRadius = 1.0f;
 const float kCosBend = std::cos(25.0f * kPi / 180.0f);
-
-struct ChainBones {
-  int count;
-  Joint joints[4];
-};
-constexpr ChainBones kLimbJoints[4] = {
-    {4, {Joint::ShoulderL, Joint::ElbowL, Joint::WristL, Joint::HandL}},
-    {4, {Joint::ShoulderR, Joint::ElbowR, Joint::WristR, Joint::HandR}},
-    {4, {Joint::HipL, Joint::KneeL, Joint::AnkleL, Joint::FootL}},
-    {4, {Joint::HipR, Joint::KneeR, Joint::AnkleR, Joint::FootR}},
-};
 
 float ringSpacing(const BodyModel& body, int first, int count, int i) {
   const auto& rings = body.rings();
@@ -87,10 +76,9 @@ void ProxyBuilder::build(const BodyModel& body, const SkeletonPose& pose) {
     const bool limb = chain != Chain::Torso && chain != Chain::Head;
     if (paper && limb) {
       // One ellipsoid per bone (paper): centred at the bone's midpoint along it.
-      const ChainBones& cb = kLimbJoints[c - static_cast<int>(Chain::ArmL)];
-      for (int k = 0; k + 1 < cb.count; ++k) {
-        const Vec3& a = pose.position[idx(cb.joints[k])];
-        const Vec3& b = pose.position[idx(cb.joints[k + 1])];
+      for (int k = 0; k + 1 < chainJointCount(chain); ++k) {
+        const Vec3& a = pose.position[idx(chainJoint(chain, k))];
+        const Vec3& b = pose.position[idx(chainJoint(chain, k + 1))];
         float radius = 0.0f;
         int ringOnBone = -1;
         for (int i = 0; i < n; ++i) {
