@@ -19,6 +19,8 @@ MassSpringSolver::MassSpringSolver(GarmentTopology topology) : topology_(std::mo
   }
   good_x_ = x_;
   good_v_ = v_;
+  prev_ = x_;
+  predicted_ = x_;
   pin_start_.resize(topology_.pinned.size());
   pin_target_.resize(topology_.pinned.size());
   for (size_t k = 0; k < topology_.pinned.size(); ++k)
@@ -87,6 +89,7 @@ bool MassSpringSolver::step(float dt, int substeps) {
   }
   for (size_t k = 0; k < pin_start_.size(); ++k)
     pin_start_[k] = x_[topology_.pinned[k]].head<3>();
+  collision_stats_ = CollisionStats{};
   const MassSpringParams& p = params_;
   const float h = dt / static_cast<float>(substeps);
   const float keep = std::exp(-p.damping * h);
@@ -97,6 +100,7 @@ bool MassSpringSolver::step(float dt, int substeps) {
     addSprings(topology_.shear, p.shear_stiffness);
     addSprings(topology_.bend, p.bend_stiffness);
     // Symplectic Euler: v += h a, x += h v (every particle independent).
+    for (size_t i = 0; i < n; ++i) prev_[i] = x_[i];
     for (size_t i = 0; i < n; ++i) {
       const float w = x_[i].w();
       if (w == 0.0f) continue;
@@ -110,6 +114,17 @@ bool MassSpringSolver::step(float dt, int substeps) {
       const Vec3 at = pin_start_[k] + t * (pin_target_[k] - pin_start_[k]);
       v_[i].head<3>() = (at - x_[i].head<3>()) / h;
       x_[i].head<3>() = at;
+    }
+    if (EllipsoidCollider* collider = motion_.beginSubstep(s, substeps)) {
+      for (size_t i = 0; i < n; ++i) predicted_[i] = x_[i];
+      const CollisionStats cs = collider->collide(x_.data(), prev_.data(), n, p.collision);
+      collision_stats_.tests += cs.tests;
+      collision_stats_.contacts += cs.contacts;
+      collision_stats_.swept_catches += cs.swept_catches;
+      collision_stats_.escapes += cs.escapes;
+      const float inv_h = 1.0f / h;
+      for (size_t i = 0; i < n; ++i)
+        v_[i].head<3>() += (x_[i].head<3>() - predicted_[i].head<3>()) * inv_h;
     }
   }
   const float limit2 = p.explosion_speed * p.explosion_speed;
@@ -127,6 +142,20 @@ bool MassSpringSolver::step(float dt, int substeps) {
     return false;
   }
   return true;
+}
+
+}  // namespace drape
+
+namespace drape {
+
+void MassSpringSolver::transform(const Mat3& R, const Vec3& pivot, const Vec3& t,
+                                 float velocity_scale) {
+  const Vec3 shift = pivot + t;
+  for (size_t i = 0; i < x_.size(); ++i) {
+    x_[i].head<3>() = R * (Vec3(x_[i].head<3>()) - pivot) + shift;
+    v_[i].head<3>() = velocity_scale * (R * Vec3(v_[i].head<3>()));
+  }
+  for (Vec3& p : pin_target_) p = R * (p - pivot) + shift;
 }
 
 }  // namespace drape

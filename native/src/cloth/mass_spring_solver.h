@@ -11,6 +11,7 @@
 // step() allocates nothing; nothing throws.
 #pragma once
 
+#include "cloth/collider_motion.h"
 #include "cloth/garment_topology.h"
 
 #include <cstddef>
@@ -28,6 +29,7 @@ struct MassSpringParams {
   float spring_damping = 0.01f;             // N s/m along each spring (relative velocity)
   float damping = 1.0f;                     // 1/s, velocity scaled by exp(-damping * h)
   float explosion_speed = 100.0f;           // m/s: faster counts as exploded
+  CollisionParams collision;                // used when collider motion is set
 };
 
 class MassSpringSolver {
@@ -39,6 +41,17 @@ class MassSpringSolver {
   const MassSpringParams& params() const { return params_; }
   // As XpbdSolver::setPinTargets.
   bool setPinTargets(const Vec3* targets, size_t count, std::string& error);
+
+  // As XpbdSolver::setColliderMotion. After each substep's Euler update the collider moves
+  // particles out of the ellipsoids and the velocity change that implies is applied too
+  // (v += correction / h), so a particle does not keep pushing into the body.
+  bool setColliderMotion(EllipsoidCollider* collider, const Ellipsoid* start, const Ellipsoid* end,
+                         int count, float margin_m, std::string& error) {
+    return motion_.set(collider, start, end, count, margin_m, error);
+  }
+  // As XpbdSolver::transform.
+  void transform(const Mat3& R, const Vec3& pivot, const Vec3& t, float velocity_scale);
+  const CollisionStats& lastCollisionStats() const { return collision_stats_; }
 
   // Rejects dt not in (0, 1] or substeps not in [1, 100000]. Returns false also when the step
   // exploded (then the state is the one before the step and explosions() grew by one).
@@ -55,7 +68,9 @@ class MassSpringSolver {
 
   GarmentTopology topology_;
   MassSpringParams params_;
-  std::vector<Eigen::Vector4f> x_, v_, f_, good_x_, good_v_;
+  std::vector<Eigen::Vector4f> x_, v_, f_, good_x_, good_v_, prev_, predicted_;
+  ColliderMotion motion_;
+  CollisionStats collision_stats_;
   std::vector<Vec3> pin_start_, pin_target_;
   uint32_t explosions_ = 0;
 };

@@ -97,12 +97,24 @@ bool XpbdSolver::step(float dt, int substeps) {
   collision_stats_ = CollisionStats{};
   const float h = dt / static_cast<float>(substeps);
   const float inv_n = 1.0f / static_cast<float>(substeps);
-  for (int s = 0; s < substeps; ++s)
-    substep(h, s + 1 == substeps ? 1.0f : static_cast<float>(s + 1) * inv_n);
+  for (int s = 0; s < substeps; ++s) {
+    const EllipsoidCollider* collider = motion_.active() ? motion_.beginSubstep(s, substeps) : collider_;
+    substep(h, s + 1 == substeps ? 1.0f : static_cast<float>(s + 1) * inv_n, collider);
+  }
   return true;
 }
 
-void XpbdSolver::substep(float h, float pin_t) {
+void XpbdSolver::transform(const Mat3& R, const Vec3& pivot, const Vec3& t, float velocity_scale) {
+  const Vec3 shift = pivot + t;
+  for (size_t i = 0; i < x_.size(); ++i) {
+    x_[i].head<3>() = R * (Vec3(x_[i].head<3>()) - pivot) + shift;
+    prev_[i].head<3>() = R * (Vec3(prev_[i].head<3>()) - pivot) + shift;
+    v_[i].head<3>() = velocity_scale * (R * Vec3(v_[i].head<3>()));
+  }
+  for (Vec3& p : pin_target_) p = R * (p - pivot) + shift;
+}
+
+void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider) {
   const XpbdParams& p = params_;
   const size_t n = x_.size();
   const Vec3 g = p.gravity;
@@ -132,8 +144,8 @@ void XpbdSolver::substep(float h, float pin_t) {
   project(topology_.bend, p.bend_compliance * inv_h2);
   projectTethers(p.tether_compliance * inv_h2);
   // 3. Collision against the tracking ellipsoids.
-  if (collider_ != nullptr) {
-    const CollisionStats cs = collider_->collide(x_.data(), prev_.data(), n, p.collision);
+  if (collider != nullptr) {
+    const CollisionStats cs = collider->collide(x_.data(), prev_.data(), n, p.collision);
     collision_stats_.tests += cs.tests;
     collision_stats_.contacts += cs.contacts;
     collision_stats_.swept_catches += cs.swept_catches;

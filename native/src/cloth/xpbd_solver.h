@@ -10,6 +10,7 @@
 // step() allocates nothing. Nothing throws: bad arguments return false and change nothing.
 #pragma once
 
+#include "cloth/collider_motion.h"
 #include "cloth/garment_topology.h"
 #include "proxies/collision.h"
 
@@ -50,10 +51,22 @@ class XpbdSolver {
   // across the substeps. Rejects a count mismatch or a non-finite target.
   bool setPinTargets(const Vec3* targets, size_t count, std::string& error);
 
-  // Optional ellipsoid collision, called once per substep after the constraints with the
-  // substep's start positions as `previous`. The caller keeps the collider alive and sets its
-  // ellipsoids (they are not interpolated by this solver across substeps). nullptr: none.
+  // Optional ellipsoid collision against fixed ellipsoids, called once per substep after the
+  // constraints with the substep's start positions as `previous`. The caller keeps the collider
+  // alive and has set its ellipsoids. nullptr: none. Replaced by setColliderMotion when that is set.
   void setCollider(const EllipsoidCollider* collider) { collider_ = collider; }
+  // Moving ellipsoids for the following steps: `start` at the step start, `end` at its end,
+  // interpolated across the substeps (cloth/collider_motion.h). The solver writes the collider's
+  // ellipsoids every substep. count 0 turns it off. Validation as ColliderMotion::set.
+  bool setColliderMotion(EllipsoidCollider* collider, const Ellipsoid* start, const Ellipsoid* end,
+                         int count, float margin_m, std::string& error) {
+    return motion_.set(collider, start, end, count, margin_m, error);
+  }
+
+  // Moves the whole state rigidly: every position (and pin target) x -> R (x - pivot) + pivot + t,
+  // velocities v -> velocity_scale * R v. Used to carry the garment with the body (inertia scaling)
+  // and to reset it on a teleport. R must be a rotation; nothing is checked (internal use).
+  void transform(const Mat3& R, const Vec3& pivot, const Vec3& t, float velocity_scale);
 
   // Teleport: all particles to `positions` (particleCount() xyz), velocities zero, pin targets =
   // the new pinned positions. Rejects a count mismatch or non-finite input.
@@ -71,7 +84,8 @@ class XpbdSolver {
   const CollisionStats& lastCollisionStats() const { return collision_stats_; }
 
  private:
-  void substep(float h, float pin_t);  // pin_t: fraction of the step at the substep end
+  // pin_t: fraction of the step at the substep end; collider: this substep's, or null.
+  void substep(float h, float pin_t, const EllipsoidCollider* collider);
   void project(const DistanceConstraints& c, float alpha_tilde);
   void projectTethers(float alpha_tilde);
 
@@ -80,6 +94,7 @@ class XpbdSolver {
   std::vector<Eigen::Vector4f> x_, prev_, v_;
   std::vector<Vec3> pin_start_, pin_target_;
   const EllipsoidCollider* collider_ = nullptr;
+  ColliderMotion motion_;
   CollisionStats collision_stats_;
 };
 

@@ -1,0 +1,39 @@
+// The body's tracking ellipsoids moving across one cloth step. A step gets the ellipsoids at its
+// start (the body of the previous frame) and at its end (this frame); every substep the collider
+// is given the pair interpolated at the substep's start and end fractions, so a limb that moves
+// 20 cm in a frame sweeps through the substeps (and the collider's swept test sees each part of
+// that sweep) instead of jumping once. Shared by both cloth solvers.
+#pragma once
+
+#include "proxies/collision.h"
+#include "proxies/ellipsoid.h"
+
+#include <string>
+#include <vector>
+
+namespace drape {
+
+class ColliderMotion {
+ public:
+  // The collider is kept by the caller and must outlive the solver's use of it. start/end: count
+  // ellipsoids each (same order); copied. Allocates only when count grows. Rejects a null
+  // collider with count > 0, null arrays with count > 0, a negative count, or a non-finite or
+  // negative margin.
+  bool set(EllipsoidCollider* collider, const Ellipsoid* start, const Ellipsoid* end, int count,
+           float margin_m, std::string& error);
+  // No collision in the next steps.
+  void clear();
+  bool active() const { return collider_ != nullptr && count_ > 0; }
+  // Gives the collider the ellipsoids of substep s of n (interpolated at s/n and (s+1)/n). The
+  // substep-end ellipsoids are kept and reused as the next substep's start.
+  EllipsoidCollider* beginSubstep(int s, int n);
+
+ private:
+  EllipsoidCollider* collider_ = nullptr;
+  std::vector<Ellipsoid> start_, end_, a_, b_;
+  int count_ = 0;
+  float margin_ = EllipsoidCollider::kDefaultMargin;
+  bool identical_ = false;  // start == end: no interpolation needed
+};
+
+}  // namespace drape
