@@ -101,6 +101,7 @@ drape_result Context::setShape(const BodyShapeInput& in, std::string& err) {
     return nonfinite ? DRAPE_ERROR_NONFINITE : DRAPE_ERROR_OUT_OF_RANGE;
   shape_ = resolveShape(in);
   body_->setShape(shape_);
+  restBody_.reset();
   shapeDirty_ = true;
   volumeDirty_ = true;
   return DRAPE_OK;
@@ -190,6 +191,7 @@ drape_result Context::update(std::string& err) {
     hasQueued_ = false;
     skeletonMs_ = msSince(t0);
     teleported_ = tracker_.teleportedLastPush();
+    teleportPending_ = teleportPending_ || teleported_;
     ++updates_;
   } else if (!shapeDirty_) {
     return DRAPE_OK;  // nothing new
@@ -242,7 +244,7 @@ void Context::fillStats(drape_frame_stats& out) {
 
 namespace drape {
 
-FidelityReport Context::measureFidelity() {
+void Context::refreshBvh() {
   // The topology never changes, so after the first build a refit follows the moved vertices.
   if (!bvhBuilt_) {
     bvh_.build(body_->positions(), body_->indices());
@@ -250,8 +252,88 @@ FidelityReport Context::measureFidelity() {
   } else {
     bvh_.refit(body_->positions());
   }
+}
+
+FidelityReport Context::measureFidelity() {
+  refreshBvh();
   const auto& e = proxies_.ellipsoids();
   return drape::measureFidelity(body_->positions(), body_->indices(), e.data(), static_cast<int>(e.size()), bvh_);
+}
+
+}  // namespace drape
+
+namespace drape {
+
+const BodyModel& Context::restBody() {
+  if (!restBody_) {
+    BodyModelParams bp;
+    bp.ring_points = static_cast<int>(desc_.ring_points);
+    bp.rings_per_segment = static_cast<int>(desc_.rings_per_segment);
+    auto b = std::make_unique<BodyModel>(shape_, bp);
+    const SkeletonPose pose = restPose(shape_);
+    b->update(pose);
+    restProxies_ = ProxyBuilder(static_cast<ProxyRule>(desc_.proxy_rule));
+    restProxies_.build(*b, pose);
+    restChains_.clear();
+    for (const ProxySource& src : restProxies_.sources()) restChains_.push_back(static_cast<int>(src.chain));
+    restBody_ = std::move(b);
+  }
+  return *restBody_;
+}
+
+const std::vector<int>& Context::restEllipsoidChains() {
+  restBody();
+  return restChains_;
+}
+
+const std::vector<Ellipsoid>& Context::restEllipsoids() {
+  restBody();
+  return restProxies_.ellipsoids();
+}
+
+GarmentSim* Context::adoptGarment(std::unique_ptr<GarmentSim> garment) {
+  garments_.push_back(std::move(garment));
+  return garments_.back().get();
+}
+
+bool Context::removeGarment(const GarmentSim* garment) {
+  for (auto it = garments_.begin(); it != garments_.end(); ++it) {
+    if (it->get() == garment) {
+      garments_.erase(it);
+      return true;
+    }
+  }
+  return false;
+}
+
+drape_result Context::step(float dt, std::string& err) {
+  if (!std::isfinite(dt)) {
+    err = "dt is not finite";
+    return DRAPE_ERROR_NONFINITE;
+  }
+  if (!(dt > 0.0f) || dt > 10.0f) {
+    err = "dt = " + std::to_string(dt) + " s is outside (0, 10]";
+    return DRAPE_ERROR_OUT_OF_RANGE;
+  }
+  if (!hasQueued_ && !updated_) {
+    err = "no skeleton frame has been accepted yet (call drape_context_push_skeleton first)";
+    return DRAPE_ERROR_CALL_ORDER;
+  }
+  if (drape_result r = update(err)) return r;
+  const auto t0 = Clock::now();
+  const std::vector<Ellipsoid>& now = proxies_.ellipsoids();
+  if (stepEllipsoids_.size() != now.size()) stepEllipsoids_ = now;
+  for (auto& g : garments_) g->step(*body_, stepEllipsoids_, now, dt, teleportPending_);
+  teleportPending_ = false;
+  stepEllipsoids_ = now;
+  stepMs_ = msSince(t0);
+  return DRAPE_OK;
+}
+
+GarmentAccuracy Context::measureGarment(const GarmentSim& garment) {
+  if (!updated_) return garment.measure(restEllipsoids(), nullptr);
+  refreshBvh();
+  return garment.measure(proxies_.ellipsoids(), &bvh_);
 }
 
 }  // namespace drape

@@ -4,6 +4,7 @@
 
 #include "body/body_model.h"
 #include "body/body_shape.h"
+#include "cloth/garment_sim.h"
 #include "proxies/fidelity.h"
 #include "proxies/mesh_bvh.h"
 #include "proxies/proxy_builder.h"
@@ -38,6 +39,23 @@ class Context {
   // Fidelity of the current ellipsoids against the current body mesh (a diagnostic: ~ms).
   FidelityReport measureFidelity();
   bool hasUpdate() const { return updated_; }
+
+  // Garments. The body in its rest pose for the current shape (what garments are fitted and
+  // dressed on), built on demand and cached until the shape changes.
+  const BodyModel& restBody();
+  const std::vector<Ellipsoid>& restEllipsoids();
+  // The chain of each ellipsoid (same order every frame).
+  const std::vector<int>& restEllipsoidChains();
+  // Takes ownership; the garment is dressed already (GarmentSim::create with restBody()).
+  GarmentSim* adoptGarment(std::unique_ptr<GarmentSim> garment);
+  // Destroys it; false when it is not this context's.
+  bool removeGarment(const GarmentSim* garment);
+  size_t garmentCount() const { return garments_.size(); }
+  // Runs update() if a frame is queued, then advances every garment by dt (seconds, (0, 10]).
+  drape_result step(float dt, std::string& err);
+  // Accuracy of a garment now, against the ellipsoids and the body mesh of the last update.
+  GarmentAccuracy measureGarment(const GarmentSim& garment);
+  double lastStepMs() const { return stepMs_; }
   void fillStats(drape_frame_stats& out);
 
  private:
@@ -48,6 +66,15 @@ class Context {
   ProxyBuilder proxies_;
   TriangleBvh bvh_;  // over the body mesh, built lazily for fidelity measurements
   bool bvhBuilt_ = false;
+  void refreshBvh();
+
+  std::unique_ptr<BodyModel> restBody_;  // rest pose of the current shape, for garments
+  ProxyBuilder restProxies_;
+  std::vector<int> restChains_;
+  std::vector<std::unique_ptr<GarmentSim>> garments_;
+  std::vector<Ellipsoid> stepEllipsoids_;  // the ellipsoids at the end of the last step
+  bool teleportPending_ = false;           // a teleport since the last step
+  double stepMs_ = 0.0;
 
   SkeletonPose queued_{};
   double queuedTime_ = 0.0;

@@ -1,5 +1,6 @@
 #include "cloth/mass_spring_solver.h"
 
+#include <chrono>
 #include <cmath>
 #include <utility>
 
@@ -90,6 +91,7 @@ bool MassSpringSolver::step(float dt, int substeps) {
   for (size_t k = 0; k < pin_start_.size(); ++k)
     pin_start_[k] = x_[topology_.pinned[k]].head<3>();
   collision_stats_ = CollisionStats{};
+  collide_ms_ = 0.0;
   const MassSpringParams& p = params_;
   const float h = dt / static_cast<float>(substeps);
   const float keep = std::exp(-p.damping * h);
@@ -117,7 +119,9 @@ bool MassSpringSolver::step(float dt, int substeps) {
     }
     if (EllipsoidCollider* collider = motion_.beginSubstep(s, substeps)) {
       for (size_t i = 0; i < n; ++i) predicted_[i] = x_[i];
+      const auto t0 = std::chrono::steady_clock::now();
       const CollisionStats cs = collider->collide(x_.data(), prev_.data(), n, p.collision);
+      collide_ms_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       collision_stats_.tests += cs.tests;
       collision_stats_.contacts += cs.contacts;
       collision_stats_.swept_catches += cs.swept_catches;
@@ -156,6 +160,29 @@ void MassSpringSolver::transform(const Mat3& R, const Vec3& pivot, const Vec3& t
     v_[i].head<3>() = velocity_scale * (R * Vec3(v_[i].head<3>()));
   }
   for (Vec3& p : pin_target_) p = R * (p - pivot) + shift;
+}
+
+}  // namespace drape
+
+namespace drape {
+
+bool MassSpringSolver::reset(const Vec3* positions, size_t count, std::string& error) {
+  if (count != x_.size() || positions == nullptr) {
+    error = "expected " + std::to_string(x_.size()) + " positions, got " + std::to_string(count);
+    return false;
+  }
+  for (size_t i = 0; i < count; ++i) {
+    if (!isFinite(positions[i])) {
+      error = "position " + std::to_string(i) + " is not finite";
+      return false;
+    }
+  }
+  for (size_t i = 0; i < count; ++i) {
+    x_[i].head<3>() = positions[i];
+    v_[i].setZero();
+  }
+  for (size_t k = 0; k < pin_target_.size(); ++k) pin_target_[k] = positions[topology_.pinned[k]];
+  return true;
 }
 
 }  // namespace drape

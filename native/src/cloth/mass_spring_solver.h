@@ -49,9 +49,13 @@ class MassSpringSolver {
                          int count, float margin_m, std::string& error) {
     return motion_.set(collider, start, end, count, margin_m, error);
   }
+  // As XpbdSolver::reset: all particles to `positions`, velocities zero, pin targets there.
+  bool reset(const Vec3* positions, size_t count, std::string& error);
   // As XpbdSolver::transform.
   void transform(const Mat3& R, const Vec3& pivot, const Vec3& t, float velocity_scale);
   const CollisionStats& lastCollisionStats() const { return collision_stats_; }
+  // Wall time spent in the collider during the last step, milliseconds.
+  double lastCollideMs() const { return collide_ms_; }
 
   // Rejects dt not in (0, 1] or substeps not in [1, 100000]. Returns false also when the step
   // exploded (then the state is the one before the step and explosions() grew by one).
@@ -71,6 +75,7 @@ class MassSpringSolver {
   std::vector<Eigen::Vector4f> x_, v_, f_, good_x_, good_v_, prev_, predicted_;
   ColliderMotion motion_;
   CollisionStats collision_stats_;
+  double collide_ms_ = 0.0;
   std::vector<Vec3> pin_start_, pin_target_;
   uint32_t explosions_ = 0;
 };

@@ -1,0 +1,429 @@
+#include "cloth/garment_sim.h"
+
+#include "body/mesh_metrics.h"
+#include "cloth/cloth_stats.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace drape {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// Frames of blend-in and of dressing run at this rate (the recording rate of a Kinect).
+constexpr float kSettleFrameS = 1.0f / 30.0f;
+
+Ellipsoid moved(const Ellipsoid& e, const Mat3& R, const Vec3& pivot, const Vec3& t) {
+  Ellipsoid m = e;
+  m.centre = R * (e.centre - pivot) + pivot + t;
+  m.rotation = R * e.rotation;
+  m.refresh();
+  return m;
+}
+
+Mat3 partialRotation(const Mat3& R, float fraction) {
+  Quat q(R);
+  q.normalize();
+  return Quat::Identity().slerp(fraction, q).toRotationMatrix();
+}
+
+}  // namespace
+
+std::string validate(const GarmentSimParams& p) {
+  std::ostringstream s;
+  auto range = [&](const char* name, float v, float lo, float hi) {
+    if (!s.str().empty()) return;
+    if (!std::isfinite(v)) s << name << " is not finite";
+    else if (v < lo || v > hi) s << name << " = " << v << " is outside [" << lo << ", " << hi << "]";
+  };
+  range("substep_hz", p.substep_hz, 30.0f, 20000.0f);
+  range("max_substeps", static_cast<float>(p.max_substeps), 1.0f, 1000.0f);
+  range("max_step_s", p.max_step_s, 1e-4f, 1.0f);
+  range("collision_margin_m", p.collision_margin_m, 0.0f, 0.05f);
+  range("linear_inertia", p.linear_inertia, 0.0f, 1.0f);
+  range("angular_inertia", p.angular_inertia, 0.0f, 1.0f);
+  range("blend_in_s", p.blend_in_s, 0.0f, 2.0f);
+  range("static_friction", p.xpbd.collision.static_friction, 0.0f, 10.0f);
+  range("kinetic_friction", p.xpbd.collision.kinetic_friction, 0.0f, 10.0f);
+  if (!s.str().empty()) return s.str();
+  if (p.xpbd.collision.response != ContactResponse::Radial &&
+      p.xpbd.collision.response != ContactResponse::Exact)
+    return "contact response is not radial (0) or exact (1)";
+  std::string err;
+  XpbdSolver probe_x(GarmentTopology{});
+  if (!probe_x.setParams(p.xpbd, err)) return err;
+  MassSpringSolver probe_m(GarmentTopology{});
+  if (!probe_m.setParams(p.mass_spring, err)) return err;
+  return {};
+}
+
+// The two solvers behind one face: what GarmentSim needs of either.
+struct GarmentSim::Solver {
+  virtual ~Solver() = default;
+  virtual bool setParams(const GarmentSimParams& p, std::string& err) = 0;
+  virtual bool setPins(const std::vector<Vec3>& pins, std::string& err) = 0;
+  virtual bool setMotion(EllipsoidCollider* c, const std::vector<Ellipsoid>& a,
+                         const std::vector<Ellipsoid>& b, float margin, std::string& err) = 0;
+  virtual void step(float dt, int substeps) = 0;
+  virtual bool reset(const std::vector<Vec3>& x, std::string& err) = 0;
+  virtual void transform(const Mat3& R, const Vec3& pivot, const Vec3& t, float vscale) = 0;
+  virtual const Eigen::Vector4f* x() const = 0;
+  virtual const Eigen::Vector4f* v() const = 0;
+  virtual CollisionStats collision() const = 0;
+  virtual double collideMs() const = 0;
+};
+
+namespace {
+
+template <class S>
+struct SolverOf : GarmentSim::Solver {
+  explicit SolverOf(GarmentTopology t) : s(std::move(t)) {}
+  bool setPins(const std::vector<Vec3>& pins, std::string& err) override {
+    return s.setPinTargets(pins.data(), pins.size(), err);
+  }
+  bool setMotion(EllipsoidCollider* c, const std::vector<Ellipsoid>& a, const std::vector<Ellipsoid>& b,
+                 float margin, std::string& err) override {
+    return s.setColliderMotion(c, a.data(), b.data(), static_cast<int>(a.size()), margin, err);
+  }
+  bool reset(const std::vector<Vec3>& x, std::string& err) override {
+    return s.reset(x.data(), x.size(), err);
+  }
+  void transform(const Mat3& R, const Vec3& pivot, const Vec3& t, float vscale) override {
+    s.transform(R, pivot, t, vscale);
+  }
+  const Eigen::Vector4f* x() const override { return s.positions(); }
+  const Eigen::Vector4f* v() const override { return s.velocities(); }
+  CollisionStats collision() const override { return s.lastCollisionStats(); }
+  S s;
+};
+
+struct XpbdFace final : SolverOf<XpbdSolver> {
+  using SolverOf::SolverOf;
+  bool setParams(const GarmentSimParams& p, std::string& err) override { return s.setParams(p.xpbd, err); }
+  void step(float dt, int n) override { s.step(dt, n); }
+  double collideMs() const override { return 0.0; }  // XpbdSolver does not time its collision yet
+};
+
+struct MassSpringFace final : SolverOf<MassSpringSolver> {
+  using SolverOf::SolverOf;
+  bool setParams(const GarmentSimParams& p, std::string& err) override {
+    MassSpringParams m = p.mass_spring;
+    m.gravity = p.xpbd.gravity;
+    m.collision = p.xpbd.collision;
+    return s.setParams(m, err);
+  }
+  void step(float dt, int n) override { s.step(dt, n); }  // an explosion restores the state itself
+  double collideMs() const override { return s.lastCollideMs(); }
+};
+
+}  // namespace
+
+GarmentSim::~GarmentSim() = default;
+
+std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const TopologyParams& topo,
+                                               ClothSolverKind solver, const GarmentSimParams& params,
+                                               float dress_time_s, const BodyModel& body_rest,
+                                               const std::vector<Ellipsoid>& rest_ellipsoids,
+                                               const std::vector<int>& ellipsoid_chains,
+                                               std::string& err) {
+  if (std::string e = validate(params); !e.empty()) {
+    err = e;
+    return nullptr;
+  }
+  if (!std::isfinite(dress_time_s) || dress_time_s < 0.0f || dress_time_s > 10.0f) {
+    err = "dress_time_s must be in [0, 10]";
+    return nullptr;
+  }
+  if (mesh.pin_ring.size() != mesh.pinned.size() || mesh.pin_local.size() != mesh.pinned.size()) {
+    err = "pinned, pin_ring and pin_local must have the same length";
+    return nullptr;
+  }
+  const int rings = static_cast<int>(body_rest.rings().size());
+  for (size_t k = 0; k < mesh.pinned.size(); ++k) {
+    if (mesh.pin_ring[k] < 0 || mesh.pin_ring[k] >= rings || !isFinite(mesh.pin_local[k])) {
+      err = "attachment " + std::to_string(k) + " names no body ring or is not finite";
+      return nullptr;
+    }
+  }
+  TopologyParams tp = topo;
+  tp.pinned = mesh.pinned;
+  std::vector<float> flat(mesh.positions.size() * 3);
+  for (size_t i = 0; i < mesh.positions.size(); ++i)
+    for (int a = 0; a < 3; ++a) flat[3 * i + static_cast<size_t>(a)] = mesh.positions[i][a];
+  std::unique_ptr<GarmentSim> g(new GarmentSim());
+  if (!buildGarmentTopology(flat.data(), mesh.positions.size(), mesh.indices.data(), mesh.indices.size(),
+                            tp, g->topology_, err))
+    return nullptr;
+  if (g->topology_.pinned.size() != mesh.pinned.size()) {
+    err = "pinned vertices must be unique";
+    return nullptr;
+  }
+  g->mesh_ = mesh;
+  // topology_.pinned is sorted; keep the attachment arrays in the same order.
+  std::vector<size_t> order(mesh.pinned.size());
+  for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return mesh.pinned[a] < mesh.pinned[b]; });
+  for (size_t k = 0; k < order.size(); ++k) {
+    g->mesh_.pinned[k] = mesh.pinned[order[k]];
+    g->mesh_.pin_ring[k] = mesh.pin_ring[order[k]];
+    g->mesh_.pin_local[k] = mesh.pin_local[order[k]];
+  }
+  if (ellipsoid_chains.size() != rest_ellipsoids.size()) {
+    err = "one chain per ellipsoid expected";
+    return nullptr;
+  }
+  g->groups_.resize(ellipsoid_chains.size());
+  for (size_t k = 0; k < ellipsoid_chains.size(); ++k)
+    g->groups_[k] = static_cast<uint8_t>(1u << std::clamp(ellipsoid_chains[k], 0, kChainCount - 1));
+  g->masks_.resize(g->mesh_.positions.size());
+  for (size_t i = 0; i < g->masks_.size(); ++i)
+    g->masks_[i] = maskForChain(nearestChain(body_rest, g->mesh_.positions[i]));
+  // PENDING-GROUPS g->collider_.setGroups(g->groups_, g->masks_.data());
+  g->kind_ = solver;
+  if (solver == ClothSolverKind::Xpbd) g->solver_ = std::make_unique<XpbdFace>(g->topology_);
+  else g->solver_ = std::make_unique<MassSpringFace>(g->topology_);
+  if (!g->setParams(params, err)) return nullptr;
+
+  g->pelvis_ring_ = body_rest.chainFirstRing(Chain::Torso);
+  const RingPose& pr = body_rest.rings()[static_cast<size_t>(g->pelvis_ring_)];
+  g->rest_pelvis_c_ = g->seen_pelvis_c_ = pr.centre;
+  g->rest_pelvis_f_ = g->seen_pelvis_f_ = pr.frame;
+  g->seen_ellipsoids_ = rest_ellipsoids;
+  g->pinTargets(body_rest, g->seen_pins_);
+
+  // Dressing: every free particle outside the inflated rest ellipsoids, then settle on them.
+  std::vector<Eigen::Vector4f> x(mesh.positions.size());
+  for (size_t i = 0; i < x.size(); ++i)
+    x[i] << g->mesh_.positions[i], g->topology_.inverse_mass[i];
+  g->collider_.setEllipsoids(rest_ellipsoids.data(), rest_ellipsoids.data(),
+                             static_cast<int>(rest_ellipsoids.size()), params.collision_margin_m);
+  g->collider_.collide(x.data(), nullptr, x.size(), params.xpbd.collision);
+  std::vector<Vec3> start(x.size());
+  for (size_t i = 0; i < x.size(); ++i) start[i] = x[i].head<3>();
+  if (!g->solver_->reset(start, err)) return nullptr;
+  const int frames = static_cast<int>(std::ceil(dress_time_s / kSettleFrameS - 1e-4f));
+  for (int f = 0; f < frames; ++f) g->runFrame(rest_ellipsoids, rest_ellipsoids, g->seen_pins_, kSettleFrameS);
+  g->dressed_.resize(x.size());
+  for (size_t i = 0; i < x.size(); ++i) g->dressed_[i] = g->solver_->x()[i].head<3>();
+  for (const Vec3& p : g->dressed_) {
+    if (!isFinite(p)) {
+      err = "the garment did not settle (non-finite positions while dressing): check its parameters";
+      return nullptr;
+    }
+  }
+  g->last_ = GarmentStepStats{};
+  return g;
+}
+
+uint8_t GarmentSim::maskForChain(int chain) {
+  const auto bit = [](Chain c) { return static_cast<uint8_t>(1u << static_cast<int>(c)); };
+  switch (static_cast<Chain>(chain)) {
+    case Chain::Torso:
+    case Chain::Head: return bit(Chain::Torso) | bit(Chain::Head);
+    case Chain::ArmL: return bit(Chain::ArmL);
+    case Chain::ArmR: return bit(Chain::ArmR);
+    case Chain::LegL: return bit(Chain::LegL) | bit(Chain::Torso);
+    case Chain::LegR: return bit(Chain::LegR) | bit(Chain::Torso);
+    default: return 0xFF;
+  }
+}
+
+int GarmentSim::nearestChain(const BodyModel& body, const Vec3& p) {
+  // Distance to the body surface, approximated by the tube between consecutive ring centres
+  // with the rings' mean semi-axis.
+  float best = std::numeric_limits<float>::infinity();
+  int chain = 0;
+  const auto& rings = body.rings();
+  for (int c = 0; c < kChainCount; ++c) {
+    const int first = body.chainFirstRing(static_cast<Chain>(c)), n = body.chainRingCount(static_cast<Chain>(c));
+    for (int r = first; r + 1 < first + n || (n == 1 && r == first); ++r) {
+      const RingPose& a = rings[static_cast<size_t>(r)];
+      const RingPose& b = rings[static_cast<size_t>(n == 1 ? r : r + 1)];
+      const Vec3 ab = b.centre - a.centre;
+      const float len2 = ab.squaredNorm();
+      const float t = len2 > 1e-12f ? std::clamp((p - a.centre).dot(ab) / len2, 0.0f, 1.0f) : 0.0f;
+      const float ra = 0.5f * (a.forward_m + a.side_m), rb = 0.5f * (b.forward_m + b.side_m);
+      const float d = (p - (a.centre + t * ab)).norm() - ((1.0f - t) * ra + t * rb);
+      if (d < best) {
+        best = d;
+        chain = c;
+      }
+    }
+  }
+  return chain;
+}
+
+bool GarmentSim::setParams(const GarmentSimParams& params, std::string& err) {
+  if (std::string e = validate(params); !e.empty()) {
+    err = e;
+    return false;
+  }
+  if (!solver_->setParams(params, err)) return false;
+  params_ = params;
+  return true;
+}
+
+size_t GarmentSim::particleCount() const { return topology_.particleCount(); }
+const Eigen::Vector4f* GarmentSim::positions() const { return solver_->x(); }
+const Eigen::Vector4f* GarmentSim::velocities() const { return solver_->v(); }
+
+void GarmentSim::pinTargets(const BodyModel& body, std::vector<Vec3>& out) const {
+  out.resize(mesh_.pinned.size());
+  for (size_t k = 0; k < out.size(); ++k) {
+    const RingPose& r = body.rings()[static_cast<size_t>(mesh_.pin_ring[k])];
+    out[k] = r.centre + r.frame * mesh_.pin_local[k];
+  }
+}
+
+void GarmentSim::runFrame(const std::vector<Ellipsoid>& start, const std::vector<Ellipsoid>& end,
+                          const std::vector<Vec3>& pins, float dt) {
+  std::string err;
+  solver_->setPins(pins, err);
+  solver_->setMotion(&collider_, start, end, params_.collision_margin_m, err);
+  const float sim = std::min(dt, params_.max_step_s);
+  const int n = std::clamp(static_cast<int>(std::ceil(sim * params_.substep_hz - 1e-3f)), 1, params_.max_substeps);
+  solver_->step(sim, n);
+  last_.substeps += n;
+  last_.collide_ms += solver_->collideMs();
+  const CollisionStats c = solver_->collision();
+  last_.collision.tests += c.tests;
+  last_.collision.contacts += c.contacts;
+  last_.collision.swept_catches += c.swept_catches;
+  last_.collision.escapes += c.escapes;
+}
+
+void GarmentSim::carry(const Mat3& R, const Vec3& pivot, const Vec3& t, float velocity_scale) {
+  solver_->transform(R, pivot, t, velocity_scale);
+}
+
+// The body jumped (first tracked frame, teleport): carry the garment rigidly with the pelvis, then
+// move the body from the carried old pose to the new one over blend_in_s, so limbs sweep the
+// garment into place instead of appearing inside it.
+void GarmentSim::blendIn(const BodyModel& body, const std::vector<Ellipsoid>& end) {
+  const RingPose& pr = body.rings()[static_cast<size_t>(pelvis_ring_)];
+  const Mat3 R = pr.frame * seen_pelvis_f_.transpose();
+  const Vec3 t = pr.centre - seen_pelvis_c_;
+  carry(R, seen_pelvis_c_, t, 0.0f);
+  ell_a_.resize(seen_ellipsoids_.size());
+  for (size_t k = 0; k < ell_a_.size(); ++k) ell_a_[k] = moved(seen_ellipsoids_[k], R, seen_pelvis_c_, t);
+  pins_a_.resize(seen_pins_.size());
+  for (size_t k = 0; k < pins_a_.size(); ++k) pins_a_[k] = R * (seen_pins_[k] - seen_pelvis_c_) + seen_pelvis_c_ + t;
+  pinTargets(body, pins_b_);
+  const int frames = static_cast<int>(std::ceil(params_.blend_in_s / kSettleFrameS - 1e-4f));
+  std::vector<Ellipsoid>& from = ell_b_;
+  from = ell_a_;
+  for (int f = 1; f <= frames; ++f) {
+    const float u = static_cast<float>(f) / static_cast<float>(frames);
+    std::vector<Ellipsoid> to(end.size());
+    for (size_t k = 0; k < to.size(); ++k) to[k] = interpolateEllipsoid(ell_a_[k], end[k], u);
+    for (size_t k = 0; k < pins_.size(); ++k) pins_[k] = pins_a_[k] + u * (pins_b_[k] - pins_a_[k]);
+    runFrame(from, to, pins_, kSettleFrameS);
+    from.swap(to);
+  }
+  last_.blend_frames = frames;
+}
+
+void GarmentSim::resetToDressed(const BodyModel& body) {
+  const RingPose& pr = body.rings()[static_cast<size_t>(pelvis_ring_)];
+  const Mat3 R = pr.frame * rest_pelvis_f_.transpose();
+  scratch3_.resize(dressed_.size());
+  for (size_t i = 0; i < dressed_.size(); ++i) scratch3_[i] = R * (dressed_[i] - rest_pelvis_c_) + pr.centre;
+  std::string err;
+  solver_->reset(scratch3_, err);
+}
+
+void GarmentSim::step(const BodyModel& body, const std::vector<Ellipsoid>& start,
+                      const std::vector<Ellipsoid>& end, float dt, bool teleported) {
+  const auto t0 = Clock::now();
+  last_ = GarmentStepStats{};
+  pins_.resize(mesh_.pinned.size());
+  const RingPose& pr = body.rings()[static_cast<size_t>(pelvis_ring_)];
+  if (!tracked_ || teleported) {
+    last_.teleport_reset = tracked_;
+    blendIn(body, end);
+    tracked_ = true;
+    pinTargets(body, pins_);
+    runFrame(end, end, pins_, dt);
+  } else {
+    // Inertia scaling: the part of the pelvis' rigid motion the garment does not feel moves it.
+    const float fl = 1.0f - params_.linear_inertia, fa = 1.0f - params_.angular_inertia;
+    if (fl > 0.0f || fa > 0.0f) {
+      const Mat3 R = partialRotation(pr.frame * seen_pelvis_f_.transpose(), fa);
+      carry(R, seen_pelvis_c_, fl * (pr.centre - seen_pelvis_c_), 1.0f);
+    }
+    pinTargets(body, pins_);
+    runFrame(start, end, pins_, dt);
+  }
+  // NaN guard (cannot happen with validated input; if it does, never hand NaN to the host).
+  const Eigen::Vector4f* x = solver_->x();
+  for (size_t i = 0; i < particleCount(); ++i) {
+    if (!x[i].allFinite()) {
+      resetToDressed(body);
+      last_.nan_reset = true;
+      break;
+    }
+  }
+  seen_pelvis_c_ = pr.centre;
+  seen_pelvis_f_ = pr.frame;
+  seen_ellipsoids_ = end;  // same size after the first step: no allocation
+  seen_pins_ = pins_;
+  ++steps_;
+  last_.total_ms = msSince(t0);
+}
+
+void GarmentSim::normals(std::vector<Vec3>& out) const {
+  std::vector<Vec3> p(particleCount());
+  const Eigen::Vector4f* x = solver_->x();
+  for (size_t i = 0; i < p.size(); ++i) p[i] = x[i].head<3>();
+  vertexNormals(p, mesh_.indices, out);
+}
+
+GarmentAccuracy GarmentSim::measure(const std::vector<Ellipsoid>& ellipsoids, const TriangleBvh* bvh) const {
+  GarmentAccuracy a;
+  std::vector<float> scratch;
+  const Eigen::Vector4f* x = solver_->x();
+  a.stretch = stretchStats(topology_, x, scratch);
+  constexpr float kInsideTol = 1e-4f;
+  for (size_t i = 0; i < particleCount(); ++i) {
+    if (!(x[i].w() > 0.0f)) continue;
+    const Vec3 p = x[i].head<3>();
+    for (const Ellipsoid& e : ellipsoids) {
+      if ((p.array() < e.bounds_min.array()).any() || (p.array() > e.bounds_max.array()).any()) continue;
+      const Vec3 q = e.toUnit(p);
+      const float r = q.norm();
+      // Depth along the ray from the centre (an upper bound of the true depth): (1 - r) * |p - c| / r.
+      if (r < 1.0f && (1.0f - r) * (p - e.centre).norm() > kInsideTol * std::max(r, 1e-6f)) {
+        ++a.proxy_inside;
+        break;
+      }
+    }
+  }
+  if (bvh != nullptr && !bvh->empty()) {
+    scratch.clear();
+    size_t deep = 0;
+    for (size_t i = 0; i < particleCount(); ++i) {
+      const float sd = bvh->signedDistance(x[i].head<3>());
+      const float depth = sd < 0.0f ? -sd * 1000.0f : 0.0f;
+      scratch.push_back(depth);
+      if (depth > 2.0f) ++deep;
+    }
+    if (!scratch.empty()) {
+      const size_t k = std::min(scratch.size() - 1, static_cast<size_t>(std::ceil(0.99 * static_cast<double>(scratch.size()))) - 1);
+      std::nth_element(scratch.begin(), scratch.begin() + static_cast<long>(k), scratch.end());
+      a.body_penetration_p99_mm = scratch[k];
+      a.body_penetration_max_mm = *std::max_element(scratch.begin(), scratch.end());
+      a.deeper_than_2mm = static_cast<float>(deep) / static_cast<float>(scratch.size());
+    }
+  }
+  return a;
+}
+
+}  // namespace drape

@@ -1,0 +1,154 @@
+// One garment worn by one tracked body: a cloth solver (XPBD by default, the paper's mass-spring
+// for comparison) plus what turns a solver into a garment that stays on a moving person:
+//  - attachments: pinned particles follow body rings (target = ring centre + frame * local);
+//  - collision with the tracking ellipsoids, interpolated from the body of the previous step to
+//    this one across the substeps (cloth/collider_motion.h);
+//  - a dressing pass at creation: pushed outside the ellipsoids of the rest pose, then settled;
+//  - inertia scaling: a fraction of the body's rigid motion (pelvis ring) carries the garment
+//    directly instead of through constraints (as NvCloth / Unity Cloth / Chaos do);
+//  - teleports and the first tracked frame: the garment is carried with the body and the body's
+//    pose is blended in from where the garment last saw it, so nothing stretches across the room;
+//  - a NaN guard: a non-finite result restores the dressed shape carried to the current body.
+// Host frame times vary: a step of dt runs ceil(dt * substep_hz) substeps (capped).
+// Method and figures: docs/garments.md. Nothing throws except std::bad_alloc.
+#pragma once
+
+#include "body/body_model.h"
+#include "cloth/cloth_stats.h"
+#include "cloth/garment_templates.h"
+#include "cloth/garment_topology.h"
+#include "cloth/mass_spring_solver.h"
+#include "cloth/xpbd_solver.h"
+#include "proxies/collision.h"
+#include "proxies/mesh_bvh.h"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace drape {
+
+enum class ClothSolverKind : int { Xpbd = 0, MassSpring = 1 };
+
+struct GarmentSimParams {
+  float substep_hz = 300.0f;    // substeps per simulated second, [30, 20000]
+  int max_substeps = 200;       // per step, [1, 1000]; a longer step gets bigger substeps
+  float max_step_s = 0.1f;      // a host frame longer than this simulates only this, (0, 1]
+  XpbdParams xpbd;              // gravity, compliances, damping, drag, wind, speed clamp, contact
+  MassSpringParams mass_spring; // used by the mass-spring solver (its collision: xpbd.collision)
+  float collision_margin_m = EllipsoidCollider::kDefaultMargin;  // cloth thickness, [0, 0.05]
+  float linear_inertia = 0.5f;  // [0, 1]: 1 = physical, 0 = carried rigidly with the pelvis
+  float angular_inertia = 0.5f; // [0, 1]: the same for the pelvis' rotation
+  float blend_in_s = 0.3f;      // first frame / teleport: pose blended in over this, [0, 2]
+};
+// Empty string when valid, else what is wrong.
+std::string validate(const GarmentSimParams& p);
+
+struct GarmentStepStats {
+  int substeps = 0;
+  int blend_frames = 0;          // extra frames run to blend a new pose in (first frame, teleport)
+  double total_ms = 0.0;         // wall time of the step
+  double collide_ms = 0.0;       // of which in the ellipsoid collision
+  CollisionStats collision;      // summed over the substeps
+  bool teleport_reset = false;
+  bool nan_reset = false;
+};
+
+struct GarmentAccuracy {
+  StretchStats stretch;                // structural edges, now
+  uint32_t proxy_inside = 0;           // free particles inside an ellipsoid (not inflated) by > 0.1 mm
+  float body_penetration_p99_mm = 0;   // depth of garment vertices inside the body mesh
+  float body_penetration_max_mm = 0;
+  float deeper_than_2mm = 0;           // fraction of vertices more than 2 mm inside the body
+};
+
+class GarmentSim {
+ public:
+  // Builds the topology (mesh.pinned attached to mesh.pin_ring/pin_local) and the solver, then
+  // dresses the garment on `body_rest` (a BodyModel updated with its rest pose) and the ellipsoids
+  // built from it: free particles pushed outside, then `dress_time_s` of settling under gravity.
+  // Null + err on bad input (mesh, pins, params).
+  // ellipsoid_chains: the body chain (Chain) each ellipsoid was built from (ProxySource::chain),
+  // for the collision groups below.
+  static std::unique_ptr<GarmentSim> create(const GarmentMesh& mesh, const TopologyParams& topo,
+                                            ClothSolverKind solver, const GarmentSimParams& params,
+                                            float dress_time_s, const BodyModel& body_rest,
+                                            const std::vector<Ellipsoid>& rest_ellipsoids,
+                                            const std::vector<int>& ellipsoid_chains,
+                                            std::string& err);
+  ~GarmentSim();
+
+  bool setParams(const GarmentSimParams& params, std::string& err);
+  const GarmentSimParams& params() const { return params_; }
+  ClothSolverKind solver() const { return kind_; }
+
+  // Advances dt seconds while the body moves from the state of the last step (`start`
+  // ellipsoids, the rings seen then) to `body` / `end` now. `teleported`: the tracker saw a jump.
+  // dt must be finite and > 0 (checked by the caller); ellipsoid counts must match creation's.
+  void step(const BodyModel& body, const std::vector<Ellipsoid>& start,
+            const std::vector<Ellipsoid>& end, float dt, bool teleported);
+
+  size_t particleCount() const;
+  const Eigen::Vector4f* positions() const;   // xyz metres, w = inverse mass (0 = pinned)
+  const Eigen::Vector4f* velocities() const;
+  const std::vector<uint32_t>& indices() const { return mesh_.indices; }
+  const GarmentTopology& topology() const { return topology_; }
+  const GarmentMesh& mesh() const { return mesh_; }
+  // Area-weighted vertex normals of the current positions (resizes `out`).
+  void normals(std::vector<Vec3>& out) const;
+  // Collision groups: each particle belongs to the body chain nearest to it on the rest body and
+  // collides only with the ellipsoids of the chains in its mask (bit c = Chain c): torso cloth
+  // with torso and head, a sleeve with its arm, a trouser leg with its leg and the torso. Where
+  // two body parts touch (an arm hanging against the torso) their ellipsoids overlap and cloth
+  // between them has no place outside both; with groups, sleeve and torso cloth each stay on
+  // their own part instead of being squeezed out through one of them.
+  const std::vector<uint8_t>& particleMasks() const { return masks_; }
+  static uint8_t maskForChain(int chain);
+  static int nearestChain(const BodyModel& body, const Vec3& p);
+
+  const GarmentStepStats& lastStep() const { return last_; }
+  uint64_t steps() const { return steps_; }
+
+  // Accuracy now against `ellipsoids` and, when `body_bvh` is non-null, the body mesh it holds.
+  GarmentAccuracy measure(const std::vector<Ellipsoid>& ellipsoids, const TriangleBvh* body_bvh) const;
+
+  struct Solver;  // the solver behind the garment (defined in the .cpp)
+
+ private:
+  GarmentSim() = default;
+  void pinTargets(const BodyModel& body, std::vector<Vec3>& out) const;
+  void runFrame(const std::vector<Ellipsoid>& start, const std::vector<Ellipsoid>& end,
+                const std::vector<Vec3>& pins, float dt);
+  void carry(const Mat3& R, const Vec3& pivot, const Vec3& t, float velocity_scale);
+  void blendIn(const BodyModel& body, const std::vector<Ellipsoid>& end);
+  void resetToDressed(const BodyModel& body);
+
+  GarmentMesh mesh_;
+  GarmentTopology topology_;
+  ClothSolverKind kind_ = ClothSolverKind::Xpbd;
+  GarmentSimParams params_;
+  std::unique_ptr<Solver> solver_;
+  EllipsoidCollider collider_;
+  std::vector<uint8_t> masks_, groups_;
+
+  // What the garment saw at the end of its last step: pelvis ring pose, ellipsoids and pin targets.
+  int pelvis_ring_ = 0;
+  Vec3 seen_pelvis_c_ = Vec3::Zero();
+  Mat3 seen_pelvis_f_ = Mat3::Identity();
+  std::vector<Ellipsoid> seen_ellipsoids_;
+  std::vector<Vec3> seen_pins_;
+  bool tracked_ = false;  // false until the first step (the garment still sits on the rest pose)
+
+  // The dressed shape on the rest pose and that pose's pelvis ring, for NaN resets.
+  std::vector<Vec3> dressed_;
+  Vec3 rest_pelvis_c_ = Vec3::Zero();
+  Mat3 rest_pelvis_f_ = Mat3::Identity();
+
+  // Per-step scratch (sized once).
+  std::vector<Vec3> pins_, pins_a_, pins_b_, scratch3_;
+  std::vector<Ellipsoid> ell_a_, ell_b_;
+  GarmentStepStats last_;
+  uint64_t steps_ = 0;
+};
+
+}  // namespace drape

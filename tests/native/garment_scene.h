@@ -1,0 +1,146 @@
+// A garment on a real recording, driven through drape::Context exactly as the C ABI drives it:
+// push each frame, step by the frame's dt, measure. Shared by the garment tests.
+#pragma once
+
+#include "capi/context.h"
+#include "cloth/garment_templates.h"
+#include "recording/recording.h"
+#include "skeleton/layouts.h"
+
+#include <algorithm>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace drape::test {
+
+struct SceneSummary {
+  int frames = 0;
+  float max_stretch = 0.0f;        // over all frames
+  float p99_stretch_worst = 0.0f;  // worst per-frame P99
+  float p99_stretch_median = 0.0f; // median per-frame P99
+  uint64_t proxy_inside = 0;       // summed over frames
+  float penetration_p99_max_mm = 0.0f;  // worst per-frame P99 depth inside the body mesh
+  float penetration_max_mm = 0.0f;
+  float max_speed = 0.0f;
+  bool finite = true;
+  int nan_resets = 0, teleport_resets = 0;
+  double step_ms_median = 0.0;
+};
+
+inline drape_context_desc defaultDesc() {
+  drape_context_desc d{};
+  d.struct_size = sizeof(d);
+  d.ring_points = 20;
+  d.rings_per_segment = 1;
+  d.calibration_frames = 30;
+  d.filter = DRAPE_FILTER_ONE_EURO;
+  const TrackerParams t;
+  d.filter_min_cutoff_hz = t.min_cutoff_hz;
+  d.filter_beta = t.beta;
+  d.filter_d_cutoff_hz = t.d_cutoff_hz;
+  d.smoothing = t.smoothing;
+  d.correction = t.correction;
+  d.prediction = t.prediction;
+  d.jitter_radius_m = t.jitter_radius_m;
+  d.max_deviation_m = t.max_deviation_m;
+  d.teleport_distance_m = t.teleport_distance_m;
+  d.proxy_rule = DRAPE_PROXY_RULE_DRAPE;
+  return d;
+}
+
+// Adds a template garment to `ctx` (dressed on the rest body).
+inline GarmentSim* addTemplate(Context& ctx, GarmentKind kind, int particles, ClothSolverKind solver,
+                               const GarmentSimParams& params, std::string& err,
+                               float dress_time_s = 0.5f) {
+  GarmentTemplateParams tp;
+  tp.kind = kind;
+  tp.target_particles = particles;
+  GarmentMesh mesh;
+  if (!makeGarmentTemplate(ctx.restBody(), tp, mesh, err)) return nullptr;
+  auto g = GarmentSim::create(mesh, TopologyParams{}, solver, params, dress_time_s, ctx.restBody(),
+                              ctx.restEllipsoids(), ctx.restEllipsoidChains(), err);
+  return g ? ctx.adoptGarment(std::move(g)) : nullptr;
+}
+
+// Pushes frame `f` of `rec` (optionally changed by `perturb`) and steps by `dt`.
+inline drape_result pushAndStep(Context& ctx, const Recording& rec, const RecordingFrame& f,
+                                double time_s, float dt, std::string& err) {
+  std::vector<drape_joint> joints(f.joints.size());
+  for (size_t j = 0; j < joints.size(); ++j) {
+    joints[j].position = {f.joints[j].position.x(), f.joints[j].position.y(), f.joints[j].position.z()};
+    joints[j].tracking_state = static_cast<int32_t>(f.joints[j].state);
+  }
+  drape_skeleton_frame sf{};
+  sf.struct_size = sizeof(sf);
+  sf.layout = static_cast<int32_t>(rec.layout);
+  sf.joint_count = static_cast<uint32_t>(joints.size());
+  sf.timestamp_s = time_s;
+  sf.joints = joints.data();
+  if (drape_result r = ctx.pushFrame(sf, err)) return r;
+  return ctx.step(dt, err);
+}
+
+// A Kinect v2 frame (25 joints) from a canonical pose: the tests' way to feed synthetic poses.
+inline RecordingFrame kinect2FromPose(const SkeletonPose& pose, double time_s) {
+  // Kinect v2 JointType order -> canonical joint.
+  static const Joint kMap[25] = {
+      Joint::Pelvis, Joint::SpineMid, Joint::Neck, Joint::Head, Joint::ShoulderL, Joint::ElbowL,
+      Joint::WristL, Joint::HandL, Joint::ShoulderR, Joint::ElbowR, Joint::WristR, Joint::HandR,
+      Joint::HipL, Joint::KneeL, Joint::AnkleL, Joint::FootL, Joint::HipR, Joint::KneeR,
+      Joint::AnkleR, Joint::FootR, Joint::SpineShoulder, Joint::HandL, Joint::HandL, Joint::HandR,
+      Joint::HandR};
+  RecordingFrame f;
+  f.time_s = time_s;
+  f.joints.resize(25);
+  for (int j = 0; j < 25; ++j) {
+    f.joints[static_cast<size_t>(j)].position = pose.position[static_cast<size_t>(kMap[j])];
+    f.joints[static_cast<size_t>(j)].state = TrackingState::Tracked;
+  }
+  return f;
+}
+
+// Replays the whole recording (frame dt from its timestamps, first frame 1/30 s) with `garment`
+// in `ctx`, measuring after every step. `per_frame` (optional) sees each frame index.
+inline SceneSummary replay(Context& ctx, GarmentSim& garment, const Recording& rec, std::string& err,
+                           bool measure_body = true,
+                           const std::function<void(int)>& per_frame = nullptr) {
+  SceneSummary s;
+  std::vector<float> p99s;
+  std::vector<double> ms;
+  double prev = rec.frames.empty() ? 0.0 : rec.frames.front().time_s - 1.0 / 30.0;
+  for (size_t i = 0; i < rec.frames.size(); ++i) {
+    const RecordingFrame& f = rec.frames[i];
+    const float dt = static_cast<float>(f.time_s - prev);
+    prev = f.time_s;
+    if (pushAndStep(ctx, rec, f, f.time_s, dt, err) != DRAPE_OK) {
+      s.finite = false;
+      return s;
+    }
+    const GarmentAccuracy a = measure_body ? ctx.measureGarment(garment)
+                                           : garment.measure(ctx.proxies().ellipsoids(), nullptr);
+    s.max_stretch = std::max(s.max_stretch, a.stretch.max);
+    p99s.push_back(a.stretch.p99);
+    s.proxy_inside += a.proxy_inside;
+    s.penetration_p99_max_mm = std::max(s.penetration_p99_max_mm, a.body_penetration_p99_mm);
+    s.penetration_max_mm = std::max(s.penetration_max_mm, a.body_penetration_max_mm);
+    s.max_speed = std::max(s.max_speed, maxSpeed(garment.velocities(), garment.particleCount()));
+    for (size_t p = 0; p < garment.particleCount(); ++p) s.finite = s.finite && garment.positions()[p].allFinite();
+    s.nan_resets += garment.lastStep().nan_reset ? 1 : 0;
+    s.teleport_resets += garment.lastStep().teleport_reset ? 1 : 0;
+    ms.push_back(garment.lastStep().total_ms);
+    if (per_frame) per_frame(static_cast<int>(i));
+    ++s.frames;
+  }
+  std::sort(p99s.begin(), p99s.end());
+  std::sort(ms.begin(), ms.end());
+  if (!p99s.empty()) {
+    s.p99_stretch_worst = p99s.back();
+    s.p99_stretch_median = p99s[p99s.size() / 2];
+    s.step_ms_median = ms[ms.size() / 2];
+  }
+  return s;
+}
+
+}  // namespace drape::test
