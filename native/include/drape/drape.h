@@ -346,6 +346,226 @@ DRAPE_API drape_result DRAPE_CALL drape_context_get_frame_stats(drape_context* c
                                                                 drape_frame_stats* out_stats);
 
 /* ------------------------------------------------------------------------------------------ */
+/* Garments                                                                                    */
+/* ------------------------------------------------------------------------------------------ */
+
+/* A garment worn by the context's person: a cloth simulated against the tracking ellipsoids,
+ * attached to the body's rings (waistband, collar). Owned by its context: destroyed with it, or
+ * earlier with drape_garment_destroy. Method: docs/garments.md. */
+typedef struct drape_garment drape_garment;
+
+typedef enum drape_garment_kind {
+  DRAPE_GARMENT_TSHIRT = 0,
+  DRAPE_GARMENT_LONG_SLEEVE = 1,
+  DRAPE_GARMENT_SKIRT = 2,
+  DRAPE_GARMENT_DRESS = 3,
+  DRAPE_GARMENT_TROUSERS = 4,
+  DRAPE_GARMENT_KIND_FORCE32 = 0x7fffffff
+} drape_garment_kind;
+
+typedef enum drape_solver {
+  DRAPE_SOLVER_XPBD = 0,        /* substepped XPBD, one iteration per substep (default) */
+  DRAPE_SOLVER_MASS_SPRING = 1, /* the paper's mass-spring + explicit Euler (needs ~3 kHz) */
+  DRAPE_SOLVER_FORCE32 = 0x7fffffff
+} drape_solver;
+
+typedef enum drape_contact_response {
+  DRAPE_CONTACT_RADIAL = 0, /* the paper: project along the ray from the ellipsoid's centre */
+  DRAPE_CONTACT_EXACT = 1,  /* closest point on the ellipsoid (default) */
+  DRAPE_CONTACT_FORCE32 = 0x7fffffff
+} drape_contact_response;
+
+/* How a garment is built, fixed for its life. */
+typedef struct drape_garment_desc {
+  uint32_t struct_size;   /* sizeof(drape_garment_desc), set by drape_garment_desc_init */
+  int32_t solver;         /* drape_solver; default DRAPE_SOLVER_XPBD */
+  float area_density;     /* kg/m^2, (0, 10]; 0.2 (a light cotton shirt) */
+  uint32_t max_tethers;   /* long-range attachments per particle, [0, 8]; 2 */
+  float dress_time_s;     /* settling on the rest pose when added, [0, 10]; 0.5 */
+  uint32_t reserved;      /* must be 0 */
+} drape_garment_desc;
+
+DRAPE_API drape_result DRAPE_CALL drape_garment_desc_init(drape_garment_desc* desc);
+
+/* A procedural garment sized to the context's body shape (docs/cloth-solver.md). */
+typedef struct drape_garment_template {
+  uint32_t struct_size;  /* sizeof(drape_garment_template), set by drape_garment_template_init */
+  int32_t kind;          /* drape_garment_kind; default DRAPE_GARMENT_TSHIRT */
+  uint32_t particles;    /* target particle count, [200, 200000] (result within 15 %); 2000 */
+  float ease_m;          /* clearance over the body, [0.002, 0.1]; 0.015 */
+  float length_scale;    /* hem / sleeve / leg lengths, [0.5, 1.5]; 1 */
+  uint32_t reserved;     /* must be 0 */
+} drape_garment_template;
+
+DRAPE_API drape_result DRAPE_CALL drape_garment_template_init(drape_garment_template* tmpl);
+
+/* Cloth parameters; may change at any time with drape_garment_set_params. */
+typedef struct drape_cloth_params {
+  uint32_t struct_size;        /* sizeof(drape_cloth_params), set by drape_cloth_params_init */
+  float substep_hz;            /* substeps per simulated second, [30, 20000]; 300 */
+  uint32_t max_substeps;       /* per step, [1, 1000]; 200 (longer steps get longer substeps) */
+  float max_step_s;            /* a longer dt simulates only this much cloth time, [1e-4, 1]; 0.1 */
+  drape_vec3 gravity;          /* m/s^2, |g| <= 1000; (0, -9.81, 0) */
+  drape_vec3 wind;             /* m/s, |w| <= 1000; 0 */
+  float drag;                  /* 1/s, pulls velocity towards the wind, [0, 1000]; 0 */
+  float damping;               /* 1/s, [0, 1000]; 1 */
+  float max_speed;             /* m/s speed clamp, [0, 1000], 0 = none; 20 */
+  float stretch_compliance;    /* XPBD compliance (m/N), [0, 1]; 0 (inextensible) */
+  float shear_compliance;      /* [0, 1]; 1e-6 */
+  float bend_compliance;       /* [0, 1]; 1e-3 */
+  float tether_compliance;     /* [0, 1]; 0 */
+  float tether_scale;          /* a particle stays within rest * scale of its anchor, [1, 10]; 1 */
+  float static_friction;       /* [0, 10]; 0.6 */
+  float kinetic_friction;      /* [0, 10]; 0.4 */
+  float collision_margin_m;    /* gap kept outside the ellipsoids (cloth thickness), [0, 0.05]; 0.004 */
+  int32_t contact_response;    /* drape_contact_response; DRAPE_CONTACT_EXACT */
+  uint32_t continuous_collision; /* 0 or 1: swept test across each substep; 1 */
+  float linear_inertia;        /* [0, 1]: 1 physical, 0 carried rigidly with the pelvis; 0.5 */
+  float angular_inertia;       /* [0, 1]; 0.5 */
+  float blend_in_s;            /* first frame and teleports: the new pose is blended in over this
+                                  much simulated time, [0, 2]; 0.3 */
+  float spring_stretch;        /* mass-spring solver only: N/m, [0, 1e6]; 100 */
+  float spring_shear;          /* N/m; 20 */
+  float spring_bend;           /* N/m; 2 */
+  float spring_damping;        /* N s/m along each spring; 0.01 */
+  uint32_t reserved;           /* must be 0 */
+} drape_cloth_params;
+
+DRAPE_API drape_result DRAPE_CALL drape_cloth_params_init(drape_cloth_params* params);
+
+/* Adds a template garment, dressed on the body's rest pose (~ms per 1 000 particles). desc and
+ * cloth may be NULL for defaults. On success *out_garment is a new handle owned by the context.
+ * Thread-safety: one thread per context. */
+DRAPE_API drape_result DRAPE_CALL drape_context_add_garment_template(drape_context* context,
+                                                                     const drape_garment_desc* desc,
+                                                                     const drape_garment_template* tmpl,
+                                                                     const drape_cloth_params* cloth,
+                                                                     drape_garment** out_garment);
+
+/* How a garment mesh made for another body is placed on this one (docs/garment-obj.md). The
+ * defaults fit MakeHuman garments (decimetres, facing +Z, A-pose, 1.60 m / 46.3 kg base mesh). */
+typedef struct drape_mesh_fit {
+  uint32_t struct_size;        /* sizeof(drape_mesh_fit), set by drape_mesh_fit_init */
+  float unit_scale;            /* metres per mesh unit, [0, 1000]; 0 = detect (1, 0.1, 0.01, 0.001) */
+  int32_t facing;              /* 0: the character faces +Z (MakeHuman, Blender glTF), 1: -Z (Drape) */
+  float source_height_m;       /* the body the mesh was made for, [0.8, 2.5]; 1.60 */
+  float source_weight_kg;      /* [15, 300]; 46.3 (docs/garment-obj.md) */
+  float source_floor_y_m;      /* where that body's feet are, after scaling, [-100, 100]; -0.82 */
+  float source_axis_z_m;       /* z of that body's vertical axis, after scaling, [-100, 100]; 0.05 */
+  float source_arm_down_deg;   /* its upper arms below horizontal, [0, 90]; 50 */
+  float source_elbow_flex_deg; /* its elbows bent forward, [0, 150]; 45 */
+  float source_leg_spread_deg; /* its legs turned outward, [0, 45]; 6 */
+  float blend_m;               /* soft choice of the body segment a vertex follows, [0, 0.2]; 0.015 */
+  uint32_t reserved;           /* must be 0 */
+} drape_mesh_fit;
+
+DRAPE_API drape_result DRAPE_CALL drape_mesh_fit_init(drape_mesh_fit* fit);
+
+/* Adds a garment from a Wavefront OBJ file (UTF-8 path) or OBJ text in memory (copied): faces of
+ * 3+ vertices, split into triangles; retargeted onto the body's rings and attached at its top
+ * boundary loops (docs/garment-obj.md). fit, desc and cloth may be NULL for defaults. */
+DRAPE_API drape_result DRAPE_CALL drape_context_add_garment_obj_file(drape_context* context,
+                                                                     const char* path,
+                                                                     const drape_mesh_fit* fit,
+                                                                     const drape_garment_desc* desc,
+                                                                     const drape_cloth_params* cloth,
+                                                                     drape_garment** out_garment);
+DRAPE_API drape_result DRAPE_CALL drape_context_add_garment_obj_memory(drape_context* context,
+                                                                       const void* data, size_t size,
+                                                                       const drape_mesh_fit* fit,
+                                                                       const drape_garment_desc* desc,
+                                                                       const drape_cloth_params* cloth,
+                                                                       drape_garment** out_garment);
+/* The same from a triangle mesh in caller arrays (copied): vertex_count positions in the mesh's
+ * units, index_count (a multiple of 3) indices, counter-clockwise seen from outside. */
+DRAPE_API drape_result DRAPE_CALL drape_context_add_garment_mesh(drape_context* context,
+                                                                 const drape_vec3* positions,
+                                                                 uint32_t vertex_count,
+                                                                 const uint32_t* indices,
+                                                                 uint32_t index_count,
+                                                                 const drape_mesh_fit* fit,
+                                                                 const drape_garment_desc* desc,
+                                                                 const drape_cloth_params* cloth,
+                                                                 drape_garment** out_garment);
+
+/* Removes the garment from its context and frees it; views into it become invalid. NULL is
+ * accepted and ignored. */
+DRAPE_API drape_result DRAPE_CALL drape_garment_destroy(drape_garment* garment);
+
+/* Replaces the cloth parameters (validated as a whole; on failure nothing changes). */
+DRAPE_API drape_result DRAPE_CALL drape_garment_set_params(drape_garment* garment,
+                                                           const drape_cloth_params* params);
+DRAPE_API drape_result DRAPE_CALL drape_garment_get_params(drape_garment* garment,
+                                                           drape_cloth_params* out_params);
+
+/* Advances the world by dt seconds (the host's frame time; it may vary from frame to frame): runs
+ * drape_context_update if a frame is queued, then every garment follows the body from where it
+ * was at the last step to where it is now, in ceil(dt * substep_hz) substeps. dt in (0, 10];
+ * DRAPE_ERROR_CALL_ORDER before the first accepted frame. Thread-safety: one thread per context. */
+DRAPE_API drape_result DRAPE_CALL drape_context_step(drape_context* context, float dt);
+
+/* Vertex and index counts of the garment mesh (fixed for the garment). Either out may be NULL. */
+DRAPE_API drape_result DRAPE_CALL drape_garment_get_mesh_size(drape_garment* garment,
+                                                              uint32_t* out_vertex_count,
+                                                              uint32_t* out_index_count);
+
+/* Copies the current garment mesh, as drape_context_read_body_mesh does for the body: each of
+ * positions, normals (vertex_capacity) and indices (index_capacity) may be NULL, not all three.
+ * Normals are computed on request (area-weighted, unit). */
+DRAPE_API drape_result DRAPE_CALL drape_garment_read_mesh(drape_garment* garment,
+                                                          drape_vec3* positions,
+                                                          drape_vec3* normals,
+                                                          uint32_t vertex_capacity,
+                                                          uint32_t* indices,
+                                                          uint32_t index_capacity);
+
+/* Borrowed view of the particle positions, no copy: *out_xyzw points at vertex_count float4
+ * (x, y, z in metres, w = inverse mass, 0 for attached particles), owned by the library and valid
+ * until the next drape_context_step, drape_garment_set_params, drape_garment_destroy or
+ * drape_context_destroy. Read-only. */
+DRAPE_API drape_result DRAPE_CALL drape_garment_view_positions(drape_garment* garment,
+                                                               const float** out_xyzw,
+                                                               uint32_t* out_vertex_count);
+
+/* What the last step did. */
+typedef struct drape_garment_stats {
+  uint32_t struct_size;     /* caller sets sizeof(drape_garment_stats) */
+  uint32_t particles;
+  uint32_t attached;        /* particles pinned to body rings */
+  uint32_t substeps;        /* in the last step (blend-in frames included) */
+  uint32_t blend_frames;    /* extra 1/30 s frames the last step ran to blend a new pose in */
+  uint32_t contacts;        /* particle-ellipsoid corrections in the last step */
+  uint32_t swept_catches;   /* of which caught by the swept test */
+  uint32_t escapes;         /* particles squeezed between overlapping ellipsoids */
+  uint64_t steps;           /* steps so far */
+  uint8_t teleport_reset;   /* 1 if the last step carried the garment across a teleport */
+  uint8_t nan_reset;        /* 1 if the last step had to restore the garment (please report) */
+  uint8_t reserved0, reserved1;
+  uint32_t reserved2;
+  double step_ms;           /* wall time of the garment's last step */
+  double collide_ms;        /* of which ellipsoid collision */
+  double integrate_ms;      /* the rest: integration and constraints */
+} drape_garment_stats;
+
+DRAPE_API drape_result DRAPE_CALL drape_garment_get_stats(drape_garment* garment,
+                                                          drape_garment_stats* out_stats);
+
+/* Accuracy of the garment now (a diagnostic, ~1 ms per 1 000 particles). */
+typedef struct drape_garment_accuracy {
+  uint32_t struct_size;            /* caller sets sizeof(drape_garment_accuracy) */
+  uint32_t proxy_inside;           /* particles inside an ellipsoid they collide with, > 0.1 mm */
+  float max_stretch;               /* structural edges: max of |len| / rest - 1 */
+  float p99_stretch;               /* its 99th percentile */
+  float mean_stretch;
+  float body_penetration_p99_mm;   /* depth of vertices inside the body mesh (0 before an update) */
+  float body_penetration_max_mm;
+  float deeper_than_2mm;           /* fraction of vertices more than 2 mm inside the body */
+} drape_garment_accuracy;
+
+DRAPE_API drape_result DRAPE_CALL drape_garment_measure(drape_garment* garment,
+                                                        drape_garment_accuracy* out_accuracy);
+
+/* ------------------------------------------------------------------------------------------ */
 /* Recordings                                                                                  */
 /* ------------------------------------------------------------------------------------------ */
 

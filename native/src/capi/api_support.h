@@ -19,7 +19,7 @@ inline drape_result ok() { return DRAPE_OK; }
 // Handles are opaque tokens, not addresses: each create hands out a value never used before, so a
 // destroyed handle stays invalid even when the allocator gives its memory to a new object, and a
 // context token is never a valid recording token. Tokens are never dereferenced.
-enum class HandleKind { Context, Recording };
+enum class HandleKind { Context, Recording, Garment };
 // Registers `object` and returns its token. Throws std::bad_alloc only (caught by guarded()).
 void* registerHandle(HandleKind kind, void* object);
 // The object behind a live token of this kind, or nullptr.

@@ -9,6 +9,10 @@
 using drape::Context;
 using namespace drape::api;
 
+namespace drape::api {
+void forgetGarments(Context& ctx);  // capi_garments.cpp
+}  // namespace drape::api
+
 namespace {
 
 // Resolves the handle into `self` (declared by the macro) or returns the error.
@@ -83,6 +87,7 @@ DRAPE_API drape_result DRAPE_CALL drape_context_destroy(drape_context* context) 
     if (!context) return DRAPE_OK;
     auto* ctx = static_cast<Context*>(unregisterHandle(HandleKind::Context, context));
     if (!ctx) return fail(DRAPE_ERROR_INVALID_HANDLE, "drape_context_destroy: context is not a live drape_context");
+    forgetGarments(*ctx);
     delete ctx;
     return DRAPE_OK;
   });

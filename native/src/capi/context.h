@@ -51,6 +51,7 @@ class Context {
   // Destroys it; false when it is not this context's.
   bool removeGarment(const GarmentSim* garment);
   size_t garmentCount() const { return garments_.size(); }
+  GarmentSim& garment(size_t i) { return *garments_[i]; }
   // Runs update() if a frame is queued, then advances every garment by dt (seconds, (0, 10]).
   drape_result step(float dt, std::string& err);
   // Accuracy of a garment now, against the ellipsoids and the body mesh of the last update.

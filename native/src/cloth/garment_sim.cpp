@@ -383,6 +383,7 @@ void GarmentSim::normals(std::vector<Vec3>& out) const {
   std::vector<Vec3> p(particleCount());
   const Eigen::Vector4f* x = solver_->x();
   for (size_t i = 0; i < p.size(); ++i) p[i] = x[i].head<3>();
+  out.resize(p.size());
   vertexNormals(p, mesh_.indices, out);
 }
 
@@ -395,7 +396,9 @@ GarmentAccuracy GarmentSim::measure(const std::vector<Ellipsoid>& ellipsoids, co
   for (size_t i = 0; i < particleCount(); ++i) {
     if (!(x[i].w() > 0.0f)) continue;
     const Vec3 p = x[i].head<3>();
-    for (const Ellipsoid& e : ellipsoids) {
+    for (size_t k = 0; k < ellipsoids.size(); ++k) {
+      if (k < groups_.size() && !(groups_[k] & masks_[i])) continue;  // not one it collides with
+      const Ellipsoid& e = ellipsoids[k];
       if ((p.array() < e.bounds_min.array()).any() || (p.array() > e.bounds_max.array()).any()) continue;
       const Vec3 q = e.toUnit(p);
       const float r = q.norm();

@@ -56,7 +56,7 @@ struct GarmentStepStats {
 
 struct GarmentAccuracy {
   StretchStats stretch;                // structural edges, now
-  uint32_t proxy_inside = 0;           // free particles inside an ellipsoid (not inflated) by > 0.1 mm
+  uint32_t proxy_inside = 0;           // free particles inside (> 0.1 mm) an ellipsoid of their groups
   float body_penetration_p99_mm = 0;   // depth of garment vertices inside the body mesh
   float body_penetration_max_mm = 0;
   float deeper_than_2mm = 0;           // fraction of vertices more than 2 mm inside the body
@@ -113,6 +113,10 @@ class GarmentSim {
   GarmentAccuracy measure(const std::vector<Ellipsoid>& ellipsoids, const TriangleBvh* body_bvh) const;
 
   struct Solver;  // the solver behind the garment (defined in the .cpp)
+
+  // Bookkeeping of the C ABI layer (its handle token and owning context); unused here.
+  void* api_token = nullptr;
+  void* api_owner = nullptr;
 
  private:
   GarmentSim() = default;

@@ -1,0 +1,362 @@
+// Garments through the C ABI: creation from templates, OBJ files, OBJ text and caller meshes;
+// parameters; stepping a real recording; reads, views, statistics; and every rejection leaving
+// the caller's buffers and the garment's state as they were.
+#include "capi_test_support.h"
+#include "test_data.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+namespace {
+
+constexpr const char* kSuit = "garments_makehuman_cc0/female_casualsuit02.obj";
+
+struct Garment {
+  drape_garment* handle = nullptr;
+};
+
+drape_garment* addTShirt(drape_context* ctx, uint32_t particles = 1000) {
+  drape_garment_template t;
+  EXPECT_EQ(drape_garment_template_init(&t), DRAPE_OK);
+  t.particles = particles;
+  drape_garment* g = nullptr;
+  EXPECT_EQ(drape_context_add_garment_template(ctx, nullptr, &t, nullptr, &g), DRAPE_OK) << lastError();
+  return g;
+}
+
+// Pushes frame i of the synthetic Kinect v2 pose (30 Hz) and steps 1/30 s.
+drape_result pushAndStep(drape_context* ctx, int i, float dx = 0.0f) {
+  std::vector<drape_joint> j = poseJoints(DRAPE_LAYOUT_KINECT2, i / 30.0);
+  for (drape_joint& q : j) q.position.x += dx;
+  const drape_skeleton_frame f = makeFrame(DRAPE_LAYOUT_KINECT2, j, i / 30.0);
+  if (drape_result r = drape_context_push_skeleton(ctx, &f)) return r;
+  return drape_context_step(ctx, 1.0f / 30.0f);
+}
+
+std::vector<float> snapshot(drape_garment* g) {
+  const float* x = nullptr;
+  uint32_t n = 0;
+  EXPECT_EQ(drape_garment_view_positions(g, &x, &n), DRAPE_OK);
+  return std::vector<float>(x, x + 4 * n);
+}
+
+bool allFinite(const std::vector<float>& v) {
+  for (float f : v)
+    if (!std::isfinite(f)) return false;
+  return true;
+}
+
+TEST(CApiGarments, InitFunctionsFillDefaults) {
+  drape_garment_desc d;
+  ASSERT_OK(drape_garment_desc_init(&d));
+  EXPECT_EQ(d.struct_size, sizeof(d));
+  EXPECT_EQ(d.solver, DRAPE_SOLVER_XPBD);
+  EXPECT_FLOAT_EQ(d.area_density, 0.2f);
+  EXPECT_EQ(d.max_tethers, 2u);
+  drape_garment_template t;
+  ASSERT_OK(drape_garment_template_init(&t));
+  EXPECT_EQ(t.kind, DRAPE_GARMENT_TSHIRT);
+  EXPECT_EQ(t.particles, 2000u);
+  drape_cloth_params c;
+  ASSERT_OK(drape_cloth_params_init(&c));
+  EXPECT_EQ(c.struct_size, sizeof(c));
+  EXPECT_FLOAT_EQ(c.substep_hz, 300.0f);
+  EXPECT_FLOAT_EQ(c.gravity.y, -9.81f);
+  EXPECT_EQ(c.contact_response, DRAPE_CONTACT_EXACT);
+  EXPECT_EQ(c.continuous_collision, 1u);
+  drape_mesh_fit f;
+  ASSERT_OK(drape_mesh_fit_init(&f));
+  EXPECT_FLOAT_EQ(f.source_height_m, 1.60f);
+  EXPECT_FAILS(DRAPE_ERROR_NULL_ARGUMENT, "drape_garment_desc_init", drape_garment_desc_init(nullptr));
+  EXPECT_FAILS(DRAPE_ERROR_NULL_ARGUMENT, "drape_garment_template_init", drape_garment_template_init(nullptr));
+  EXPECT_FAILS(DRAPE_ERROR_NULL_ARGUMENT, "drape_cloth_params_init", drape_cloth_params_init(nullptr));
+  EXPECT_FAILS(DRAPE_ERROR_NULL_ARGUMENT, "drape_mesh_fit_init", drape_mesh_fit_init(nullptr));
+}
+
+TEST(CApiGarments, TemplateGarmentFollowsTheBody) {
+  ContextPtr ctx = makeContext();
+  drape_garment* g = addTShirt(ctx.get());
+  ASSERT_NE(g, nullptr);
+  uint32_t nv = 0, ni = 0;
+  ASSERT_OK(drape_garment_get_mesh_size(g, &nv, &ni));
+  EXPECT_GT(nv, 800u);
+  EXPECT_EQ(ni % 3, 0u);
+  // Before any frame: the dressed garment can be read, but the world cannot step.
+  std::vector<drape_vec3> pos(nv), nrm(nv);
+  std::vector<uint32_t> idx(ni);
+  ASSERT_OK(drape_garment_read_mesh(g, pos.data(), nrm.data(), nv, idx.data(), ni));
+  EXPECT_FAILS(DRAPE_ERROR_CALL_ORDER, "drape_context_step", drape_context_step(ctx.get(), 1.0f / 30.0f));
+  for (int i = 0; i < 45; ++i) ASSERT_OK(pushAndStep(ctx.get(), i));
+  ASSERT_OK(drape_garment_read_mesh(g, pos.data(), nrm.data(), nv, idx.data(), ni));
+  const std::vector<float> view = snapshot(g);
+  ASSERT_EQ(view.size(), 4u * nv);
+  for (uint32_t i = 0; i < nv; ++i) {
+    EXPECT_EQ(pos[i].x, view[4 * i]);
+    EXPECT_EQ(pos[i].y, view[4 * i + 1]);
+    EXPECT_EQ(pos[i].z, view[4 * i + 2]);
+    EXPECT_NEAR(std::sqrt(nrm[i].x * nrm[i].x + nrm[i].y * nrm[i].y + nrm[i].z * nrm[i].z), 1.0f, 1e-3f);
+  }
+  for (uint32_t i : idx) EXPECT_LT(i, nv);
+  EXPECT_TRUE(allFinite(view));
+  // The shirt moved with the body: it sits around the pelvis-to-neck span of the pose.
+  float ymin = 1e9f, ymax = -1e9f;
+  for (const drape_vec3& p : pos) {
+    ymin = std::min(ymin, p.y);
+    ymax = std::max(ymax, p.y);
+  }
+  const std::array<V, 25> k = kinect2Pose(44 / 30.0);
+  EXPECT_LT(ymin, k[0].y);   // hem below the spine base
+  EXPECT_GT(ymax, k[20].y);  // collar above the spine-shoulder joint
+  EXPECT_LT(ymax, k[3].y);   // below the head
+  drape_garment_stats s;
+  s.struct_size = sizeof(s);
+  ASSERT_OK(drape_garment_get_stats(g, &s));
+  EXPECT_EQ(s.particles, nv);
+  EXPECT_GT(s.attached, 0u);
+  EXPECT_EQ(s.steps, 45u);
+  EXPECT_GE(s.substeps, 10u);
+  EXPECT_GT(s.step_ms, 0.0);
+  EXPECT_GE(s.integrate_ms, 0.0);
+  drape_garment_accuracy a;
+  a.struct_size = sizeof(a);
+  ASSERT_OK(drape_garment_measure(g, &a));
+  EXPECT_EQ(a.proxy_inside, 0u);
+  EXPECT_TRUE(std::isfinite(a.p99_stretch));
+  EXPECT_LT(a.p99_stretch, 0.10f);
+  EXPECT_GE(a.max_stretch, a.p99_stretch);
+}
+
+TEST(CApiGarments, SameInputGivesBitIdenticalGarments) {
+  ContextPtr a = makeContext(), b = makeContext();
+  drape_garment* ga = addTShirt(a.get());
+  drape_garment* gb = addTShirt(b.get());
+  for (int i = 0; i < 20; ++i) {
+    ASSERT_OK(pushAndStep(a.get(), i));
+    ASSERT_OK(pushAndStep(b.get(), i));
+  }
+  const std::vector<float> xa = snapshot(ga), xb = snapshot(gb);
+  ASSERT_EQ(xa.size(), xb.size());
+  EXPECT_EQ(std::memcmp(xa.data(), xb.data(), xa.size() * sizeof(float)), 0);
+}
+
+TEST(CApiGarments, BadParametersAreRejectedAndChangeNothing) {
+  ContextPtr ctx = makeContext();
+  drape_garment* g = addTShirt(ctx.get(), 400);
+  drape_cloth_params before;
+  before.struct_size = sizeof(before);
+  ASSERT_OK(drape_garment_get_params(g, &before));
+  struct Case {
+    const char* name;
+    std::function<void(drape_cloth_params&)> change;
+    drape_result code;
+  };
+  const Case cases[] = {
+      {"NaN compliance", [](drape_cloth_params& p) { p.stretch_compliance = kNaN; }, DRAPE_ERROR_NONFINITE},
+      {"negative compliance", [](drape_cloth_params& p) { p.bend_compliance = -1.0f; }, DRAPE_ERROR_OUT_OF_RANGE},
+      {"Inf gravity", [](drape_cloth_params& p) { p.gravity.y = kInf; }, DRAPE_ERROR_NONFINITE},
+      {"substep_hz too low", [](drape_cloth_params& p) { p.substep_hz = 10.0f; }, DRAPE_ERROR_OUT_OF_RANGE},
+      {"tether_scale below 1", [](drape_cloth_params& p) { p.tether_scale = 0.5f; }, DRAPE_ERROR_OUT_OF_RANGE},
+      {"contact response 7", [](drape_cloth_params& p) { p.contact_response = 7; }, DRAPE_ERROR_OUT_OF_RANGE},
+      {"inertia above 1", [](drape_cloth_params& p) { p.linear_inertia = 1.5f; }, DRAPE_ERROR_OUT_OF_RANGE},
+      {"negative spring", [](drape_cloth_params& p) { p.spring_stretch = -3.0f; }, DRAPE_ERROR_OUT_OF_RANGE},
+      {"reserved", [](drape_cloth_params& p) { p.reserved = 1; }, DRAPE_ERROR_INVALID_ARGUMENT},
+      {"struct_size", [](drape_cloth_params& p) { p.struct_size = 8; }, DRAPE_ERROR_INVALID_ARGUMENT},
+  };
+  for (const Case& c : cases) {
+    drape_cloth_params p = before;
+    c.change(p);
+    EXPECT_FAILS(c.code, "drape_garment_set_params", drape_garment_set_params(g, &p)) << c.name;
+    drape_cloth_params now;
+    now.struct_size = sizeof(now);
+    ASSERT_OK(drape_garment_get_params(g, &now));
+    EXPECT_EQ(std::memcmp(&now, &before, sizeof(now)), 0) << c.name;
+  }
+  drape_cloth_params p = before;
+  p.damping = 3.0f;
+  ASSERT_OK(drape_garment_set_params(g, &p));
+  drape_cloth_params now;
+  now.struct_size = sizeof(now);
+  ASSERT_OK(drape_garment_get_params(g, &now));
+  EXPECT_FLOAT_EQ(now.damping, 3.0f);
+  EXPECT_FAILS(DRAPE_ERROR_NULL_ARGUMENT, "drape_garment_set_params", drape_garment_set_params(g, nullptr));
+  EXPECT_FAILS(DRAPE_ERROR_NULL_ARGUMENT, "drape_garment_get_params", drape_garment_get_params(g, nullptr));
+  // A rejected step leaves the garment as it was.
+  ASSERT_OK(pushAndStep(ctx.get(), 0));
+  const std::vector<float> x0 = snapshot(g);
+  EXPECT_FAILS(DRAPE_ERROR_NONFINITE, "drape_context_step", drape_context_step(ctx.get(), kNaN));
+  EXPECT_FAILS(DRAPE_ERROR_OUT_OF_RANGE, "drape_context_step", drape_context_step(ctx.get(), -0.01f));
+  EXPECT_FAILS(DRAPE_ERROR_OUT_OF_RANGE, "drape_context_step", drape_context_step(ctx.get(), 0.0f));
+  EXPECT_FAILS(DRAPE_ERROR_OUT_OF_RANGE, "drape_context_step", drape_context_step(ctx.get(), 11.0f));
+  EXPECT_EQ(snapshot(g), x0);
+}
+
+TEST(CApiGarments, BadGarmentInputIsRejectedAndCreatesNothing) {
+  ContextPtr ctx = makeContext();
+  drape_garment* const sentinel = reinterpret_cast<drape_garment*>(uintptr_t{0x1234});
+  drape_garment* g = sentinel;
+  drape_garment_desc d;
+  drape_garment_desc_init(&d);
+  d.area_density = -1.0f;
+  EXPECT_FAILS(DRAPE_ERROR_OUT_OF_RANGE, "drape_context_add_garment_template",
+               drape_context_add_garment_template(ctx.get(), &d, nullptr, nullptr, &g));
+  drape_garment_desc_init(&d);
+  d.area_density = kNaN;
+  EXPECT_FAILS(DRAPE_ERROR_NONFINITE, "drape_context_add_garment_template",
+               drape_context_add_garment_template(ctx.get(), &d, nullptr, nullptr, &g));
+  drape_garment_desc_init(&d);
+  d.solver = 5;
+  EXPECT_FAILS(DRAPE_ERROR_OUT_OF_RANGE, "drape_context_add_garment_template",
+               drape_context_add_garment_template(ctx.get(), &d, nullptr, nullptr, &g));
+  drape_garment_template t;
+  drape_garment_template_init(&t);
+  t.kind = 9;
+  EXPECT_FAILS(DRAPE_ERROR_OUT_OF_RANGE, "drape_context_add_garment_template",
+               drape_context_add_garment_template(ctx.get(), nullptr, &t, nullptr, &g));
+  drape_garment_template_init(&t);
+  t.particles = 10;
+  EXPECT_FAILS(DRAPE_ERROR_OUT_OF_RANGE, "drape_context_add_garment_template",
+               drape_context_add_garment_template(ctx.get(), nullptr, &t, nullptr, &g));
+  EXPECT_FAILS(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_add_garment_template",
+               drape_context_add_garment_template(ctx.get(), nullptr, nullptr, nullptr, nullptr));
+  EXPECT_FAILS(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_add_garment_template",
+               drape_context_add_garment_template(nullptr, nullptr, nullptr, nullptr, &g));
+
+  // Caller meshes: empty, index out of range, NaN vertex, degenerate triangle.
+  const drape_vec3 quad[4] = {{0, 1, 2.4f}, {0.3f, 1, 2.4f}, {0.3f, 1.3f, 2.4f}, {0, 1.3f, 2.4f}};
+  const uint32_t tris[6] = {0, 1, 2, 0, 2, 3};
+  drape_mesh_fit fit;
+  drape_mesh_fit_init(&fit);
+  fit.unit_scale = 1.0f;
+  fit.facing = 1;
+  EXPECT_FAILS(DRAPE_ERROR_INVALID_ARGUMENT, "drape_context_add_garment_mesh",
+               drape_context_add_garment_mesh(ctx.get(), quad, 0, tris, 6, &fit, nullptr, nullptr, &g));
+  const uint32_t bad[6] = {0, 1, 2, 0, 2, 4};
+  EXPECT_FAILS(DRAPE_ERROR_OUT_OF_RANGE, "drape_context_add_garment_mesh",
+               drape_context_add_garment_mesh(ctx.get(), quad, 4, bad, 6, &fit, nullptr, nullptr, &g));
+  drape_vec3 nanQuad[4] = {quad[0], quad[1], quad[2], quad[3]};
+  nanQuad[2].y = kNaN;
+  EXPECT_FAILS(DRAPE_ERROR_NONFINITE, "drape_context_add_garment_mesh",
+               drape_context_add_garment_mesh(ctx.get(), nanQuad, 4, tris, 6, &fit, nullptr, nullptr, &g));
+  const uint32_t degenerate[6] = {0, 1, 1, 0, 2, 3};
+  EXPECT_FAILS(DRAPE_ERROR_INVALID_ARGUMENT, "drape_context_add_garment_mesh",
+               drape_context_add_garment_mesh(ctx.get(), quad, 4, degenerate, 6, &fit, nullptr, nullptr, &g));
+  drape_mesh_fit_init(&fit);
+  fit.source_height_m = 7.0f;
+  EXPECT_FAILS(DRAPE_ERROR_OUT_OF_RANGE, "drape_context_add_garment_mesh",
+               drape_context_add_garment_mesh(ctx.get(), quad, 4, tris, 6, &fit, nullptr, nullptr, &g));
+  // OBJ: missing file, garbage text.
+  EXPECT_FAILS(DRAPE_ERROR_IO, "drape_context_add_garment_obj_file",
+               drape_context_add_garment_obj_file(ctx.get(), "/nonexistent/shirt.obj", nullptr, nullptr, nullptr, &g));
+  const char garbage[] = "v 1 2 3\nf 1 2 banana\n";
+  EXPECT_FAILS(DRAPE_ERROR_PARSE, "drape_context_add_garment_obj_memory",
+               drape_context_add_garment_obj_memory(ctx.get(), garbage, sizeof(garbage) - 1, nullptr, nullptr, nullptr, &g));
+  EXPECT_FAILS(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_add_garment_obj_memory",
+               drape_context_add_garment_obj_memory(ctx.get(), nullptr, 10, nullptr, nullptr, nullptr, &g));
+  EXPECT_EQ(g, sentinel);
+}
+
+TEST(CApiGarments, CallerMeshAndObjGarments) {
+  ContextPtr ctx = makeContext();
+  // A small square of cloth in Drape's own frame and metres, in front of the chest.
+  const drape_vec3 quad[4] = {{-0.1f, 1.1f, 2.3f}, {0.1f, 1.1f, 2.3f}, {0.1f, 1.3f, 2.3f}, {-0.1f, 1.3f, 2.3f}};
+  const uint32_t tris[6] = {0, 1, 2, 0, 2, 3};
+  drape_mesh_fit fit;
+  drape_mesh_fit_init(&fit);
+  fit.unit_scale = 1.0f;
+  fit.facing = 1;
+  fit.source_floor_y_m = 0.0f;
+  fit.source_axis_z_m = 2.5f;
+  drape_garment* patch = nullptr;
+  ASSERT_OK(drape_context_add_garment_mesh(ctx.get(), quad, 4, tris, 6, &fit, nullptr, nullptr, &patch));
+  uint32_t nv = 0;
+  ASSERT_OK(drape_garment_get_mesh_size(patch, &nv, nullptr));
+  EXPECT_EQ(nv, 4u);
+  DRAPE_REQUIRE_SHARED(path, kSuit);
+  drape_garment* suit = nullptr;
+  ASSERT_OK(drape_context_add_garment_obj_file(ctx.get(), path.c_str(), nullptr, nullptr, nullptr, &suit));
+  ASSERT_OK(drape_garment_get_mesh_size(suit, &nv, nullptr));
+  EXPECT_EQ(nv, 2876u);
+  drape_garment_stats s;
+  s.struct_size = sizeof(s);
+  ASSERT_OK(drape_garment_get_stats(suit, &s));
+  EXPECT_GT(s.attached, 0u);  // waistband and collar
+  for (int i = 0; i < 10; ++i) ASSERT_OK(pushAndStep(ctx.get(), i));
+  EXPECT_TRUE(allFinite(snapshot(suit)));
+  EXPECT_TRUE(allFinite(snapshot(patch)));
+}
+
+TEST(CApiGarments, BuffersTooSmallAreLeftUntouched) {
+  ContextPtr ctx = makeContext();
+  drape_garment* g = addTShirt(ctx.get(), 400);
+  uint32_t nv = 0, ni = 0;
+  ASSERT_OK(drape_garment_get_mesh_size(g, &nv, &ni));
+  std::vector<drape_vec3> pos(nv - 1, drape_vec3{7, 7, 7});
+  std::vector<uint32_t> idx(ni - 1, 7u);
+  EXPECT_FAILS(DRAPE_ERROR_BUFFER_TOO_SMALL, "drape_garment_read_mesh",
+               drape_garment_read_mesh(g, pos.data(), nullptr, nv - 1, nullptr, 0));
+  EXPECT_FAILS(DRAPE_ERROR_BUFFER_TOO_SMALL, "drape_garment_read_mesh",
+               drape_garment_read_mesh(g, nullptr, nullptr, 0, idx.data(), ni - 1));
+  for (const drape_vec3& p : pos) EXPECT_EQ(p.x, 7.0f);
+  for (uint32_t i : idx) EXPECT_EQ(i, 7u);
+  EXPECT_FAILS(DRAPE_ERROR_NULL_ARGUMENT, "drape_garment_read_mesh", drape_garment_read_mesh(g, nullptr, nullptr, 0, nullptr, 0));
+  EXPECT_FAILS(DRAPE_ERROR_NULL_ARGUMENT, "drape_garment_get_mesh_size", drape_garment_get_mesh_size(g, nullptr, nullptr));
+  EXPECT_FAILS(DRAPE_ERROR_NULL_ARGUMENT, "drape_garment_view_positions", drape_garment_view_positions(g, nullptr, nullptr));
+  drape_garment_stats s;
+  s.struct_size = 4;
+  EXPECT_FAILS(DRAPE_ERROR_INVALID_ARGUMENT, "drape_garment_get_stats", drape_garment_get_stats(g, &s));
+  drape_garment_accuracy a;
+  a.struct_size = 4;
+  EXPECT_FAILS(DRAPE_ERROR_INVALID_ARGUMENT, "drape_garment_measure", drape_garment_measure(g, &a));
+}
+
+TEST(CApiGarments, HandlesDieWithTheirGarmentAndContext) {
+  ContextPtr ctx = makeContext();
+  drape_garment* a = addTShirt(ctx.get(), 400);
+  drape_garment* b = addTShirt(ctx.get(), 400);
+  ASSERT_OK(drape_garment_destroy(a));
+  uint32_t nv = 0;
+  EXPECT_FAILS(DRAPE_ERROR_INVALID_HANDLE, "drape_garment_get_mesh_size", drape_garment_get_mesh_size(a, &nv, nullptr));
+  EXPECT_FAILS(DRAPE_ERROR_INVALID_HANDLE, "drape_garment_destroy", drape_garment_destroy(a));
+  EXPECT_OK(drape_garment_destroy(nullptr));
+  ASSERT_OK(pushAndStep(ctx.get(), 0));  // the remaining garment still steps
+  ASSERT_OK(drape_garment_get_mesh_size(b, &nv, nullptr));
+  drape_context_destroy(ctx.release());
+  EXPECT_FAILS(DRAPE_ERROR_INVALID_HANDLE, "drape_garment_get_mesh_size", drape_garment_get_mesh_size(b, &nv, nullptr));
+  const float* x = nullptr;
+  EXPECT_FAILS(DRAPE_ERROR_INVALID_HANDLE, "drape_garment_view_positions", drape_garment_view_positions(b, &x, nullptr));
+  // A context token is not a garment token.
+  ContextPtr other = makeContext();
+  EXPECT_FAILS(DRAPE_ERROR_INVALID_HANDLE, "drape_garment_destroy",
+               drape_garment_destroy(reinterpret_cast<drape_garment*>(other.get())));
+}
+
+// A 2 m teleport of the whole skeleton: the garment is carried with the body (no stretch across
+// the room) and back to its normal stretch within a second.
+TEST(CApiGarments, SurvivesATwoMetreTeleport) {
+  ContextPtr ctx = makeContext();
+  drape_garment* g = addTShirt(ctx.get());
+  drape_garment_accuracy a;
+  a.struct_size = sizeof(a);
+  int i = 0;
+  for (; i < 60; ++i) ASSERT_OK(pushAndStep(ctx.get(), i));
+  ASSERT_OK(drape_garment_measure(g, &a));
+  const float settled = a.p99_stretch;
+  ASSERT_OK(pushAndStep(ctx.get(), i++, 2.0f));
+  drape_garment_stats s;
+  s.struct_size = sizeof(s);
+  ASSERT_OK(drape_garment_get_stats(g, &s));
+  EXPECT_EQ(s.teleport_reset, 1);
+  ASSERT_OK(drape_garment_measure(g, &a));
+  EXPECT_LT(a.max_stretch, 1.0f) << "the garment stretched across the jump";
+  for (int k = 0; k < 30; ++k, ++i) ASSERT_OK(pushAndStep(ctx.get(), i, 2.0f));
+  ASSERT_OK(drape_garment_measure(g, &a));
+  EXPECT_LT(a.p99_stretch, settled + 0.02f);
+  EXPECT_EQ(a.proxy_inside, 0u);
+  EXPECT_TRUE(allFinite(snapshot(g)));
+}
+
+}  // namespace
