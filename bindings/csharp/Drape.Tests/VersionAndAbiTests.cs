@@ -104,7 +104,8 @@ namespace Drape.Tests
                     // Blittable signatures only: nothing for the marshaller to convert.
                     foreach (Type t in m.GetParameters().Select(p => p.ParameterType).Append(m.ReturnType))
                         Assert.True(t.IsPointer || t == typeof(IntPtr) || t == typeof(UIntPtr) || t == typeof(uint) ||
-                                    t == typeof(int) || t == typeof(void) || t == typeof(double) || t.IsEnum,
+                                    t == typeof(int) || t == typeof(void) || t == typeof(float) || t == typeof(double) ||
+                                    t.IsEnum,
                                     $"{m.Name}: parameter type {t} is not a plain blittable type");
                 }
             }
@@ -175,10 +176,159 @@ namespace Drape.Tests
             ("BodyToProxyMaxMm", 16), ("ProxyToBodyMeanMm", 20), ("ProxyToBodyP95Mm", 24), ("ProxyToBodyMaxMm", 28),
             ("OutsideFraction", 32), ("Reserved", 36));
 
+        // Garments: sizes asserted at the end of native/src/capi/capi_garments.cpp (but drape_cloth_params,
+        // 124 bytes: C layout rules, checked with offsetof when this table was written).
+        [Fact]
+        public void GarmentDesc_Is24() => AssertLayout<GarmentDesc>(24,
+            ("StructSize", 0), ("Solver", 4), ("AreaDensity", 8), ("MaxTethers", 12), ("DressTimeS", 16), ("Reserved", 20));
+
+        [Fact]
+        public void GarmentTemplate_Is24() => AssertLayout<GarmentTemplate>(24,
+            ("StructSize", 0), ("Kind", 4), ("Particles", 8), ("EaseM", 12), ("LengthScale", 16), ("Reserved", 20));
+
+        [Fact]
+        public void ClothParams_Is124() => AssertLayout<ClothParams>(124,
+            ("StructSize", 0), ("SubstepHz", 4), ("MaxSubsteps", 8), ("MaxStepS", 12), ("Gravity", 16), ("Wind", 28),
+            ("Drag", 40), ("Damping", 44), ("MaxSpeed", 48), ("StretchCompliance", 52), ("ShearCompliance", 56),
+            ("BendCompliance", 60), ("TetherCompliance", 64), ("TetherScale", 68), ("StaticFriction", 72),
+            ("KineticFriction", 76), ("CollisionMarginM", 80), ("ContactResponse", 84), ("ContinuousCollision", 88),
+            ("LinearInertia", 92), ("AngularInertia", 96), ("BlendInS", 100), ("SpringStretch", 104),
+            ("SpringShear", 108), ("SpringBend", 112), ("SpringDamping", 116), ("Reserved", 120));
+
+        [Fact]
+        public void MeshFit_Is48() => AssertLayout<MeshFit>(48,
+            ("StructSize", 0), ("UnitScale", 4), ("Facing", 8), ("SourceHeightM", 12), ("SourceWeightKg", 16),
+            ("SourceFloorYM", 20), ("SourceAxisZM", 24), ("SourceArmDownDeg", 28), ("SourceElbowFlexDeg", 32),
+            ("SourceLegSpreadDeg", 36), ("BlendM", 40), ("Reserved", 44));
+
+        [Fact]
+        public void GarmentStats_Is72() => AssertLayout<GarmentStats>(72,
+            ("StructSize", 0), ("Particles", 4), ("Attached", 8), ("Substeps", 12), ("BlendFrames", 16), ("Contacts", 20),
+            ("SweptCatches", 24), ("Escapes", 28), ("Steps", 32), ("TeleportReset", 40), ("NanReset", 41),
+            ("Reserved0", 42), ("Reserved1", 43), ("Reserved2", 44), ("StepMs", 48), ("CollideMs", 56),
+            ("IntegrateMs", 64));
+
+        [Fact]
+        public void GarmentAccuracy_Is32() => AssertLayout<GarmentAccuracy>(32,
+            ("StructSize", 0), ("ProxyInside", 4), ("MaxStretch", 8), ("P99Stretch", 12), ("MeanStretch", 16),
+            ("BodyPenetrationP99Mm", 20), ("BodyPenetrationMaxMm", 24), ("DeeperThan2mm", 28));
+
         [Fact]
         public void RecordingInfo_Is32() => AssertLayout<RecordingInfo>(32,
             ("StructSize", 0), ("Format", 4), ("Layout", 8), ("JointCount", 12), ("FrameCount", 16),
             ("NominalRateHz", 20), ("DurationS", 24));
+
+        // ---- Every struct of the header, laid out from its text ------------------------------------
+        //
+        // The tables above were written by hand; this test recomputes the layout of every
+        // `typedef struct` in drape.h with the C rules (each field at the next multiple of its
+        // alignment, the size rounded up to the largest alignment), so a field added to or moved in
+        // the header fails here until the C# mirror follows.
+
+        private static readonly Dictionary<string, Type> s_structs = new Dictionary<string, Type>
+        {
+            ["drape_vec3"] = typeof(Vector3f),
+            ["drape_quat"] = typeof(Quaternionf),
+            ["drape_joint"] = typeof(Joint),
+            ["drape_context_desc"] = typeof(ContextDesc),
+            ["drape_body_shape"] = typeof(BodyShape),
+            ["drape_skeleton_frame"] = typeof(SkeletonFrame),
+            ["drape_ellipsoid"] = typeof(Ellipsoid),
+            ["drape_proxy_fidelity"] = typeof(ProxyFidelity),
+            ["drape_frame_stats"] = typeof(FrameStats),
+            ["drape_garment_desc"] = typeof(GarmentDesc),
+            ["drape_garment_template"] = typeof(GarmentTemplate),
+            ["drape_cloth_params"] = typeof(ClothParams),
+            ["drape_mesh_fit"] = typeof(MeshFit),
+            ["drape_garment_stats"] = typeof(GarmentStats),
+            ["drape_garment_accuracy"] = typeof(GarmentAccuracy),
+            ["drape_recording_info"] = typeof(RecordingInfo),
+        };
+
+        private static Dictionary<string, string> HeaderStructBodies()
+        {
+            string h = Regex.Replace(TestEnvironment.HeaderText, @"/\*.*?\*/", " ", RegexOptions.Singleline);
+            return Regex.Matches(h, @"typedef\s+struct\s+(\w+)\s*\{([^}]*)\}\s*\1\s*;")
+                .ToDictionary(m => m.Groups[1].Value, m => m.Groups[2].Value);
+        }
+
+        /// <summary>(name, offset) of each field and the struct's size and alignment, by the C rules.</summary>
+        private static (List<(string Name, int Offset)> Fields, int Size, int Align) CLayout(
+            string body, Dictionary<string, string> all)
+        {
+            var fields = new List<(string, int)>();
+            int offset = 0, maxAlign = 1;
+            foreach (string decl in body.Split(';').Select(d => d.Trim()).Where(d => d.Length > 0))
+            {
+                Match m = Regex.Match(decl, @"^(?:const\s+)?(\w+)\s*(\**)\s*(.*)$", RegexOptions.Singleline);
+                Assert.True(m.Success, $"cannot parse the declaration '{decl}'");
+                string type = m.Groups[1].Value;
+                bool pointer = m.Groups[2].Value.Length > 0;
+                string[] names = m.Groups[3].Value.Split(',').Select(n => n.Trim()).ToArray();
+                int size, align;
+                if (pointer || names.Any(n => n.StartsWith("*")))
+                {
+                    size = align = IntPtr.Size;
+                    names = names.Select(n => n.TrimStart('*', ' ')).ToArray();
+                }
+                else
+                {
+                    switch (type)
+                    {
+                        case "uint8_t": size = align = 1; break;
+                        case "int32_t": case "uint32_t": case "float": size = align = 4; break;
+                        case "uint64_t": case "double": size = align = 8; break;
+                        default:
+                            Assert.True(all.ContainsKey(type), $"unknown field type {type} in drape.h");
+                            (_, size, align) = CLayout(all[type], all);
+                            break;
+                    }
+                }
+                foreach (string name in names)
+                {
+                    Assert.Matches(@"^\w+$", name);
+                    offset = (offset + align - 1) / align * align;
+                    fields.Add((name, offset));
+                    offset += size;
+                }
+                maxAlign = Math.Max(maxAlign, align);
+            }
+            return (fields, (offset + maxAlign - 1) / maxAlign * maxAlign, maxAlign);
+        }
+
+        [Fact]
+        public void EveryHeaderStruct_HasAMirror_WithTheSameFieldsOffsetsAndSize()
+        {
+            Dictionary<string, string> bodies = HeaderStructBodies();
+            Assert.True(bodies.Count >= 16, $"parsed only {bodies.Count} structs from drape.h");
+            Assert.Equal(bodies.Keys.OrderBy(k => k), s_structs.Keys.OrderBy(k => k));
+            MethodInfo sizeOf = typeof(StructLayoutTests).GetMethod(nameof(SizeOf), BindingFlags.Static | BindingFlags.NonPublic)!;
+            foreach (var (cName, body) in bodies)
+            {
+                Type cs = s_structs[cName];
+                var (fields, size, _) = CLayout(body, bodies);
+                FieldInfo[] csFields = cs.GetFields(BindingFlags.Instance | BindingFlags.Public | BindingFlags.NonPublic);
+                Assert.True(fields.Count == csFields.Length,
+                            $"{cName} has {fields.Count} fields, {cs.Name} {csFields.Length}");
+                for (int i = 0; i < fields.Count; ++i)
+                {
+                    string c = fields[i].Name.Replace("_", "");
+                    Assert.True(string.Equals(c, csFields[i].Name, StringComparison.OrdinalIgnoreCase),
+                                $"{cName} field {i} is {fields[i].Name}, {cs.Name} has {csFields[i].Name}");
+                    Assert.True(fields[i].Offset == (int)Marshal.OffsetOf(cs, csFields[i].Name),
+                                $"{cName}.{fields[i].Name} at {fields[i].Offset}, {cs.Name}.{csFields[i].Name} at {Marshal.OffsetOf(cs, csFields[i].Name)}");
+                }
+                Assert.True(size == (int)sizeOf.MakeGenericMethod(cs).Invoke(null, null)!, $"{cName} is {size} bytes, {cs.Name} not");
+                Assert.Equal(size, Marshal.SizeOf(cs));
+            }
+        }
+
+        [Fact]
+        public void EveryHeaderEnum_IsInTheEnumTable()
+        {
+            var header = Regex.Matches(TestEnvironment.HeaderText, @"typedef\s+enum\s+(\w+)").Select(m => m.Groups[1].Value);
+            Assert.Equal(header.OrderBy(n => n), Enums().Select(e => (string)e[0]).OrderBy(n => n));
+        }
 
         public static IEnumerable<object[]> Enums() => new[]
         {
@@ -189,6 +339,10 @@ namespace Drape.Tests
             new object[] { "drape_filter", typeof(Filter) },
             new object[] { "drape_sex", typeof(Sex) },
             new object[] { "drape_recording_format", typeof(RecordingFormat) },
+            new object[] { "drape_garment_kind", typeof(GarmentKind) },
+            new object[] { "drape_solver", typeof(Solver) },
+            new object[] { "drape_contact_response", typeof(ContactResponse) },
+            new object[] { "drape_mesh_facing", typeof(MeshFacing) },
         };
 
         /// <summary>Every enumerator of the C enum (but *_FORCE32) has the C# member whose name, upper-cased,

@@ -1,23 +1,30 @@
 using System;
+using System.Collections.Generic;
 
 namespace Drape
 {
     /// <summary>
-    /// One tracked person (drape_context): skeleton in, body mesh out.
+    /// One tracked person (drape_context): skeleton in, body mesh and garments out.
     /// <para>Owns its native handle: call <see cref="Dispose"/> (or use <c>using</c>). Not
     /// thread-safe: one thread at a time, Dispose included (the C ABI's rule). Different
     /// contexts may be used on different threads at once.</para>
     /// <para>A context that is garbage-collected without Dispose is leaked, not freed: its
     /// finalizer calls no native code and only reports the leak
     /// (<see cref="DrapeLibrary.LeakedHandleCount"/>, <see cref="DrapeLibrary.HandleLeaked"/>).</para>
+    /// <para>The context owns its <see cref="Garment"/>s: disposing it destroys them and makes
+    /// every later call on them throw <see cref="ObjectDisposedException"/>.</para>
     /// </summary>
     public sealed unsafe class Context : IDisposable
     {
         private IntPtr _handle;
+        private readonly List<Garment> _garments;
+        private readonly System.Collections.ObjectModel.ReadOnlyCollection<Garment> _garmentsView;
 
         /// <summary>Creates a context with the default settings.</summary>
         public Context()
         {
+            _garments = new List<Garment>();
+            _garmentsView = _garments.AsReadOnly();
             DrapeLibrary.EnsureCompatible();
             IntPtr h;
             DrapeException.Check(Native.drape_context_create(null, &h));
@@ -28,6 +35,8 @@ namespace Drape
         /// <see cref="ContextDesc.CreateDefault"/> (a zero StructSize is rejected).</summary>
         public Context(in ContextDesc desc)
         {
+            _garments = new List<Garment>();
+            _garmentsView = _garments.AsReadOnly();
             DrapeLibrary.EnsureCompatible();
             IntPtr h;
             ContextDesc d = desc;
@@ -42,13 +51,16 @@ namespace Drape
         /// <summary>True once <see cref="Dispose"/> has run.</summary>
         public bool IsDisposed => _handle == IntPtr.Zero;
 
-        /// <summary>Destroys the native context (drape_context_destroy). Idempotent.</summary>
+        /// <summary>Destroys the native context (drape_context_destroy) and with it every garment
+        /// it still owns (their objects become disposed). Idempotent.</summary>
         public void Dispose()
         {
             IntPtr h = _handle;
             if (h == IntPtr.Zero) return;
             _handle = IntPtr.Zero;
             GC.SuppressFinalize(this);
+            foreach (Garment g in _garments) g.Orphan();
+            _garments.Clear();
             // Cannot fail for a handle this object created; nothing useful to do if it did.
             Native.drape_context_destroy(h);
         }
@@ -176,6 +188,119 @@ namespace Drape
                 DrapeException.Check(Native.drape_context_read_body_mesh(
                     h, pp, pn, (uint)vertexCapacity, pi, (uint)indices.Length));
             }
+        }
+
+        // ---- Garments ----------------------------------------------------------------------------
+
+        /// <summary>The garments this context owns now, in the order they were added (disposed ones
+        /// are removed).</summary>
+        public IReadOnlyList<Garment> Garments => _garmentsView;
+
+        internal void Forget(Garment garment) => _garments.Remove(garment);
+
+        private Garment Adopt(IntPtr garmentHandle)
+        {
+            var g = new Garment(this, garmentHandle);
+            _garments.Add(g);
+            return g;
+        }
+
+        /// <summary>
+        /// Adds a procedural garment sized to the body shape and dressed on the body's rest pose
+        /// (drape_context_add_garment_template; about a millisecond per 1 000 particles, plus the
+        /// settling of <see cref="GarmentDesc.DressTimeS"/>). Start <paramref name="template"/> from
+        /// <see cref="GarmentTemplate.CreateDefault(GarmentKind)"/>; <paramref name="desc"/> and
+        /// <paramref name="cloth"/> default to the library's defaults when null.
+        /// </summary>
+        public Garment AddGarment(in GarmentTemplate template, GarmentDesc? desc = null, ClothParams? cloth = null)
+        {
+            IntPtr h = Live;
+            GarmentTemplate t = template;
+            GarmentDesc d = desc.GetValueOrDefault();
+            ClothParams c = cloth.GetValueOrDefault();
+            IntPtr g;
+            DrapeException.Check(Native.drape_context_add_garment_template(
+                h, desc.HasValue ? &d : null, &t, cloth.HasValue ? &c : null, &g));
+            return Adopt(g);
+        }
+
+        /// <summary>
+        /// Adds a garment from a Wavefront OBJ file (drape_context_add_garment_obj_file; the path is
+        /// passed as UTF-8): faces of 3+ vertices, retargeted onto this body by
+        /// <paramref name="fit"/> (null: MakeHuman's defaults, see docs/garment-obj.md) and attached
+        /// at its top boundary loop (waistband, collar) when one winds around the torso. Throws
+        /// <see cref="ResultCode.Io"/> when the file cannot be read and <see cref="ResultCode.Parse"/>
+        /// when it is not OBJ.
+        /// </summary>
+        public Garment AddGarmentObj(string path, MeshFit? fit = null, GarmentDesc? desc = null, ClothParams? cloth = null)
+        {
+            IntPtr h = Live;
+            byte[] utf8 = Utf8.ToNative(path, nameof(path));
+            MeshFit f = fit.GetValueOrDefault();
+            GarmentDesc d = desc.GetValueOrDefault();
+            ClothParams c = cloth.GetValueOrDefault();
+            IntPtr g;
+            fixed (byte* p = utf8)
+                DrapeException.Check(Native.drape_context_add_garment_obj_file(
+                    h, p, fit.HasValue ? &f : null, desc.HasValue ? &d : null, cloth.HasValue ? &c : null, &g));
+            return Adopt(g);
+        }
+
+        /// <summary>As <see cref="AddGarmentObj"/>, from OBJ text in memory
+        /// (drape_context_add_garment_obj_memory; the bytes are copied). A byte[] converts implicitly.</summary>
+        public Garment AddGarmentObjMemory(ReadOnlySpan<byte> objText, MeshFit? fit = null, GarmentDesc? desc = null,
+                                           ClothParams? cloth = null)
+        {
+            IntPtr h = Live;
+            MeshFit f = fit.GetValueOrDefault();
+            GarmentDesc d = desc.GetValueOrDefault();
+            ClothParams c = cloth.GetValueOrDefault();
+            IntPtr g;
+            byte none = 0;  // an empty span is empty text (a Parse error), not a NULL pointer
+            fixed (byte* p = objText)
+                DrapeException.Check(Native.drape_context_add_garment_obj_memory(
+                    h, p != null ? p : &none, (UIntPtr)(uint)objText.Length, fit.HasValue ? &f : null,
+                    desc.HasValue ? &d : null, cloth.HasValue ? &c : null, &g));
+            return Adopt(g);
+        }
+
+        /// <summary>
+        /// Adds a garment from a triangle mesh (drape_context_add_garment_mesh; copied):
+        /// <paramref name="positions"/> in the mesh's own units (placed as <paramref name="fit"/>
+        /// says, as for OBJ files), <paramref name="indices"/> a multiple of 3, counter-clockwise
+        /// seen from outside. A <c>UnityEngine.Vector3</c> span can be passed with
+        /// <c>MemoryMarshal.Cast&lt;Vector3, Vector3f&gt;</c>.
+        /// </summary>
+        public Garment AddGarmentMesh(ReadOnlySpan<Vector3f> positions, ReadOnlySpan<uint> indices, MeshFit? fit = null,
+                                      GarmentDesc? desc = null, ClothParams? cloth = null)
+        {
+            IntPtr h = Live;
+            MeshFit f = fit.GetValueOrDefault();
+            GarmentDesc d = desc.GetValueOrDefault();
+            ClothParams c = cloth.GetValueOrDefault();
+            IntPtr g;
+            Vector3f noVertex;
+            uint noIndex;
+            fixed (Vector3f* pp = positions)
+            fixed (uint* pi = indices)
+                DrapeException.Check(Native.drape_context_add_garment_mesh(
+                    h, pp != null ? pp : &noVertex, (uint)positions.Length, pi != null ? pi : &noIndex,
+                    (uint)indices.Length, fit.HasValue ? &f : null, desc.HasValue ? &d : null,
+                    cloth.HasValue ? &c : null, &g));
+            return Adopt(g);
+        }
+
+        /// <summary>
+        /// Advances the world by <paramref name="dt"/> seconds, the host's frame time, in (0, 10]
+        /// (drape_context_step): runs <see cref="Update"/> if a frame is queued, then every garment
+        /// follows the body from where it was at the last step, in ceil(dt * SubstepHz) substeps.
+        /// Throws <see cref="ResultCode.CallOrder"/> before the first accepted frame. Invalidates
+        /// every <see cref="Garment.ViewPositions"/> span. No managed allocation.
+        /// </summary>
+        public void Step(float dt)
+        {
+            IntPtr h = Live;
+            DrapeException.Check(Native.drape_context_step(h, dt));
         }
 
         // ---- Statistics --------------------------------------------------------------------------

@@ -2,7 +2,7 @@
 // header's order and with the header's names. Drape.Tests checks that the two lists agree
 // (NativeApiTests), so a function added to the header without a line here fails CI.
 //
-// Only blittable types cross: pointers, IntPtr/UIntPtr, int/uint/double, int-backed enums and the
+// Only blittable types cross: pointers, IntPtr/UIntPtr, int/uint/float/double, int-backed enums and the
 // blittable structs of Types.cs. Nothing is marshalled (no bool, no string, no array): strings
 // coming back are `const char*` (IntPtr, decoded by Utf8.FromNative), strings going in are
 // NUL-terminated UTF-8 byte buffers (Utf8.ToNative). Handles are opaque IntPtr.
@@ -114,6 +114,88 @@ namespace Drape
 
         [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
         internal static extern ResultCode drape_context_get_frame_stats(IntPtr context, FrameStats* outStats);
+
+        // ---- Garments --------------------------------------------------------------------------
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_garment_desc_init(GarmentDesc* desc);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_garment_template_init(GarmentTemplate* tmpl);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_cloth_params_init(ClothParams* parameters);
+
+        /// <param name="context">drape_context*.</param>
+        /// <param name="desc">optional (NULL: defaults).</param>
+        /// <param name="tmpl">optional (NULL: the default T-shirt).</param>
+        /// <param name="cloth">optional (NULL: defaults).</param>
+        /// <param name="outGarment">receives the new drape_garment*, owned by the context.</param>
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_add_garment_template(IntPtr context, GarmentDesc* desc,
+            GarmentTemplate* tmpl, ClothParams* cloth, IntPtr* outGarment);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_mesh_fit_init(MeshFit* fit);
+
+        /// <param name="context">drape_context*.</param>
+        /// <param name="pathUtf8">NUL-terminated UTF-8 path (see Utf8.ToNative).</param>
+        /// <param name="fit">optional (NULL: defaults).</param>
+        /// <param name="desc">optional (NULL: defaults).</param>
+        /// <param name="cloth">optional (NULL: defaults).</param>
+        /// <param name="outGarment">receives the new drape_garment*, owned by the context.</param>
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_add_garment_obj_file(IntPtr context, byte* pathUtf8,
+            MeshFit* fit, GarmentDesc* desc, ClothParams* cloth, IntPtr* outGarment);
+
+        /// <param name="context">drape_context*.</param>
+        /// <param name="data">OBJ text (copied by the library).</param>
+        /// <param name="size">size_t byte count.</param>
+        /// <param name="fit">optional (NULL: defaults).</param>
+        /// <param name="desc">optional (NULL: defaults).</param>
+        /// <param name="cloth">optional (NULL: defaults).</param>
+        /// <param name="outGarment">receives the new drape_garment*, owned by the context.</param>
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_add_garment_obj_memory(IntPtr context, void* data, UIntPtr size,
+            MeshFit* fit, GarmentDesc* desc, ClothParams* cloth, IntPtr* outGarment);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_add_garment_mesh(IntPtr context, Vector3f* positions,
+            uint vertexCount, uint* indices, uint indexCount, MeshFit* fit, GarmentDesc* desc, ClothParams* cloth,
+            IntPtr* outGarment);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_garment_destroy(IntPtr garment);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_garment_set_params(IntPtr garment, ClothParams* parameters);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_garment_get_params(IntPtr garment, ClothParams* outParams);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_step(IntPtr context, float dt);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_garment_get_mesh_size(IntPtr garment, uint* outVertexCount,
+                                                                      uint* outIndexCount);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_garment_read_mesh(IntPtr garment, Vector3f* positions, Vector3f* normals,
+                                                                  uint vertexCapacity, uint* indices, uint indexCapacity);
+
+        /// <param name="garment">drape_garment*.</param>
+        /// <param name="outXyzw">receives a library-owned pointer to vertex_count float4 (x, y, z, inverse mass).</param>
+        /// <param name="outVertexCount">optional.</param>
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_garment_view_positions(IntPtr garment, float** outXyzw,
+                                                                       uint* outVertexCount);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_garment_get_stats(IntPtr garment, GarmentStats* outStats);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_garment_measure(IntPtr garment, GarmentAccuracy* outAccuracy);
 
         // ---- Recordings ------------------------------------------------------------------------
 

@@ -5,7 +5,8 @@
 //    uint32_t -> uint, int32_t -> int or an int-backed enum, float -> float, double -> double,
 //    uint8_t -> byte, pointers -> pointers. No bool, no string, no array: every struct is
 //    blittable, so P/Invoke passes a pointer to it and copies nothing.
-//  - Sizes are asserted natively (capi_context.cpp) and in Drape.Tests (StructLayoutTests).
+//  - Sizes are asserted natively (capi_context.cpp, capi_garments.cpp) and in Drape.Tests
+//    (StructLayoutTests).
 //  - Enum-typed fields are declared `: int`, the same 4 bytes as the C enum / int32_t they
 //    replace; a value the binding does not know yet (from a newer library) is kept as is.
 using System;
@@ -110,6 +111,49 @@ namespace Drape
         Bvh = 2,
         /// <summary>DRAPE_RECORDING_DRAPE: Drape's own text format.</summary>
         Drape = 3,
+    }
+
+    /// <summary>drape_garment_kind: the procedural garment templates.</summary>
+    public enum GarmentKind : int
+    {
+        /// <summary>DRAPE_GARMENT_TSHIRT: short sleeves; the default.</summary>
+        TShirt = 0,
+        /// <summary>DRAPE_GARMENT_LONG_SLEEVE.</summary>
+        LongSleeve = 1,
+        /// <summary>DRAPE_GARMENT_SKIRT.</summary>
+        Skirt = 2,
+        /// <summary>DRAPE_GARMENT_DRESS.</summary>
+        Dress = 3,
+        /// <summary>DRAPE_GARMENT_TROUSERS.</summary>
+        Trousers = 4,
+    }
+
+    /// <summary>drape_solver: the cloth solver of a garment (fixed for its life).</summary>
+    public enum Solver : int
+    {
+        /// <summary>DRAPE_SOLVER_XPBD: substepped XPBD, one iteration per substep; the default.</summary>
+        Xpbd = 0,
+        /// <summary>DRAPE_SOLVER_MASS_SPRING: the paper's mass-spring + explicit Euler (needs ~3 kHz substeps).</summary>
+        MassSpring = 1,
+    }
+
+    /// <summary>drape_contact_response: how a particle inside an ellipsoid is pushed out.</summary>
+    public enum ContactResponse : int
+    {
+        /// <summary>DRAPE_CONTACT_RADIAL: the paper's projection along the ray from the ellipsoid's centre.</summary>
+        Radial = 0,
+        /// <summary>DRAPE_CONTACT_EXACT: the closest point on the ellipsoid; the default.</summary>
+        Exact = 1,
+    }
+
+    /// <summary>drape_mesh_facing (drape_mesh_fit.facing): which way the
+    /// character a garment mesh was made for faces.</summary>
+    public enum MeshFacing : int
+    {
+        /// <summary>0: the character faces +Z (MakeHuman, Blender's glTF export); the default.</summary>
+        PlusZ = 0,
+        /// <summary>1: the character faces -Z (Drape's own camera space).</summary>
+        MinusZ = 1,
     }
 
     /// <summary>drape_vec3 (12 bytes): metres, right-handed camera space. Same layout as
@@ -404,5 +448,255 @@ namespace Drape
         public float OutsideFraction;
         /// <summary>reserved.</summary>
         public float Reserved;
+    }
+
+    /// <summary>drape_garment_desc (24 bytes): how a garment is built, fixed for its life. Start
+    /// from <see cref="CreateDefault"/>.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct GarmentDesc
+    {
+        /// <summary>struct_size: sizeof(drape_garment_desc); set by CreateDefault.</summary>
+        public uint StructSize;
+        /// <summary>solver (int32_t in C); default <see cref="Drape.Solver.Xpbd"/>.</summary>
+        public Solver Solver;
+        /// <summary>area_density: kg/m^2, (0, 10]; default 0.2 (a light cotton shirt).</summary>
+        public float AreaDensity;
+        /// <summary>max_tethers: long-range attachments per particle, [0, 8]; default 2.</summary>
+        public uint MaxTethers;
+        /// <summary>dress_time_s: settling on the rest pose when added, [0, 10]; default 0.5.</summary>
+        public float DressTimeS;
+        /// <summary>reserved: 0.</summary>
+        public uint Reserved;
+
+        /// <summary>The library's defaults (drape_garment_desc_init).</summary>
+        public static unsafe GarmentDesc CreateDefault()
+        {
+            DrapeLibrary.EnsureCompatible();
+            GarmentDesc d;
+            DrapeException.Check(Native.drape_garment_desc_init(&d));
+            return d;
+        }
+    }
+
+    /// <summary>drape_garment_template (24 bytes): a procedural garment sized to the context's
+    /// body shape. Start from <see cref="CreateDefault(GarmentKind)"/>.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct GarmentTemplate
+    {
+        /// <summary>struct_size: sizeof(drape_garment_template); set by CreateDefault.</summary>
+        public uint StructSize;
+        /// <summary>kind (int32_t in C); default <see cref="GarmentKind.TShirt"/>.</summary>
+        public GarmentKind Kind;
+        /// <summary>particles: target particle count, [200, 200000] (the result is within 15 %); default 2000.</summary>
+        public uint Particles;
+        /// <summary>ease_m: clearance over the body, [0.002, 0.1]; default 0.015.</summary>
+        public float EaseM;
+        /// <summary>length_scale: hem / sleeve / leg lengths, [0.5, 1.5]; default 1.</summary>
+        public float LengthScale;
+        /// <summary>reserved: 0.</summary>
+        public uint Reserved;
+
+        /// <summary>The library's defaults (drape_garment_template_init), a T-shirt.</summary>
+        public static GarmentTemplate CreateDefault() => CreateDefault(GarmentKind.TShirt);
+
+        /// <summary>The library's defaults (drape_garment_template_init) with <see cref="Kind"/> = <paramref name="kind"/>.</summary>
+        public static unsafe GarmentTemplate CreateDefault(GarmentKind kind)
+        {
+            DrapeLibrary.EnsureCompatible();
+            GarmentTemplate t;
+            DrapeException.Check(Native.drape_garment_template_init(&t));
+            t.Kind = kind;
+            return t;
+        }
+    }
+
+    /// <summary>drape_cloth_params (124 bytes): the cloth parameters of a garment; they may change
+    /// at any time (<see cref="Garment.Params"/>). Start from <see cref="CreateDefault"/>. Ranges are
+    /// checked by the library as a whole: NaN/Inf gives <see cref="ResultCode.NonFinite"/>, a value
+    /// outside its range <see cref="ResultCode.OutOfRange"/>.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct ClothParams
+    {
+        /// <summary>struct_size: sizeof(drape_cloth_params); set by CreateDefault.</summary>
+        public uint StructSize;
+        /// <summary>substep_hz: substeps per simulated second, [30, 20000]; default 300.</summary>
+        public float SubstepHz;
+        /// <summary>max_substeps: per step, [1, 1000]; default 200 (longer steps get longer substeps).</summary>
+        public uint MaxSubsteps;
+        /// <summary>max_step_s: a longer dt simulates only this much cloth time, [1e-4, 1]; default 0.1.</summary>
+        public float MaxStepS;
+        /// <summary>gravity: m/s^2, |g| &lt;= 1000 per component; default (0, -9.81, 0).</summary>
+        public Vector3f Gravity;
+        /// <summary>wind: m/s, |w| &lt;= 1000 per component; default 0.</summary>
+        public Vector3f Wind;
+        /// <summary>drag: 1/s, pulls velocity towards the wind, [0, 1000]; default 0.</summary>
+        public float Drag;
+        /// <summary>damping: 1/s, [0, 1000]; default 1.</summary>
+        public float Damping;
+        /// <summary>max_speed: m/s speed clamp, [0, 1000], 0 = none; default 20.</summary>
+        public float MaxSpeed;
+        /// <summary>stretch_compliance: XPBD compliance (m/N), [0, 1]; default 0 (inextensible).</summary>
+        public float StretchCompliance;
+        /// <summary>shear_compliance: [0, 1]; default 1e-6.</summary>
+        public float ShearCompliance;
+        /// <summary>bend_compliance: [0, 1]; default 1e-3.</summary>
+        public float BendCompliance;
+        /// <summary>tether_compliance: [0, 1]; default 0.</summary>
+        public float TetherCompliance;
+        /// <summary>tether_scale: a particle stays within rest * scale of its anchor, [1, 10]; default 1.</summary>
+        public float TetherScale;
+        /// <summary>static_friction: [0, 10]; default 0.6.</summary>
+        public float StaticFriction;
+        /// <summary>kinetic_friction: [0, 10]; default 0.4.</summary>
+        public float KineticFriction;
+        /// <summary>collision_margin_m: gap kept outside the ellipsoids (cloth thickness), [0, 0.05]; default 0.004.</summary>
+        public float CollisionMarginM;
+        /// <summary>contact_response (int32_t in C); default <see cref="Drape.ContactResponse.Exact"/>.</summary>
+        public ContactResponse ContactResponse;
+        /// <summary>continuous_collision (uint32_t 0 or 1): swept test across each substep; default 1.
+        /// See <see cref="IsContinuousCollision"/>.</summary>
+        public uint ContinuousCollision;
+        /// <summary>linear_inertia: [0, 1]: 1 physical, 0 carried rigidly with the pelvis; default 0.5.</summary>
+        public float LinearInertia;
+        /// <summary>angular_inertia: [0, 1]; default 0.5.</summary>
+        public float AngularInertia;
+        /// <summary>blend_in_s: first frame and teleports blend the new pose in over this much
+        /// simulated time, [0, 2]; default 0.3.</summary>
+        public float BlendInS;
+        /// <summary>spring_stretch: mass-spring solver only, N/m, [0, 1e6]; default 100.</summary>
+        public float SpringStretch;
+        /// <summary>spring_shear: mass-spring solver only, N/m; default 20.</summary>
+        public float SpringShear;
+        /// <summary>spring_bend: mass-spring solver only, N/m; default 2.</summary>
+        public float SpringBend;
+        /// <summary>spring_damping: mass-spring solver only, N s/m along each spring; default 0.01.</summary>
+        public float SpringDamping;
+        /// <summary>reserved: 0.</summary>
+        public uint Reserved;
+
+        /// <summary><see cref="ContinuousCollision"/> as a bool.</summary>
+        public bool IsContinuousCollision
+        {
+            get => ContinuousCollision != 0;
+            set => ContinuousCollision = value ? 1u : 0u;
+        }
+
+        /// <summary>The library's defaults (drape_cloth_params_init).</summary>
+        public static unsafe ClothParams CreateDefault()
+        {
+            DrapeLibrary.EnsureCompatible();
+            ClothParams p;
+            DrapeException.Check(Native.drape_cloth_params_init(&p));
+            return p;
+        }
+    }
+
+    /// <summary>drape_mesh_fit (48 bytes): how a garment mesh made for another body is placed on
+    /// this one (docs/garment-obj.md). The defaults (<see cref="CreateDefault"/>) fit MakeHuman
+    /// garments: decimetres, facing +Z, A-pose, a 1.60 m / 46.3 kg base mesh.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct MeshFit
+    {
+        /// <summary>struct_size: sizeof(drape_mesh_fit); set by CreateDefault.</summary>
+        public uint StructSize;
+        /// <summary>unit_scale: metres per mesh unit, [0, 1000]; default 0 = detect (1, 0.1, 0.01, 0.001).</summary>
+        public float UnitScale;
+        /// <summary>facing: drape_mesh_facing; default <see cref="MeshFacing.PlusZ"/>.</summary>
+        public MeshFacing Facing;
+        /// <summary>source_height_m: the body the mesh was made for, [0.8, 2.5]; default 1.60.</summary>
+        public float SourceHeightM;
+        /// <summary>source_weight_kg: [15, 300]; default 46.3.</summary>
+        public float SourceWeightKg;
+        /// <summary>source_floor_y_m: where that body's feet are, after scaling, [-100, 100]; default -0.82.</summary>
+        public float SourceFloorYM;
+        /// <summary>source_axis_z_m: z of that body's vertical axis, after scaling, [-100, 100]; default 0.05.</summary>
+        public float SourceAxisZM;
+        /// <summary>source_arm_down_deg: its upper arms below horizontal, [0, 90]; default 50.</summary>
+        public float SourceArmDownDeg;
+        /// <summary>source_elbow_flex_deg: its elbows bent forward, [0, 150]; default 45.</summary>
+        public float SourceElbowFlexDeg;
+        /// <summary>source_leg_spread_deg: its legs turned outward, [0, 45]; default 6.</summary>
+        public float SourceLegSpreadDeg;
+        /// <summary>blend_m: soft choice of the body segment a vertex follows, [0, 0.2]; default 0.015.</summary>
+        public float BlendM;
+        /// <summary>reserved: 0.</summary>
+        public uint Reserved;
+
+        /// <summary>The library's defaults (drape_mesh_fit_init): MakeHuman garments.</summary>
+        public static unsafe MeshFit CreateDefault()
+        {
+            DrapeLibrary.EnsureCompatible();
+            MeshFit f;
+            DrapeException.Check(Native.drape_mesh_fit_init(&f));
+            return f;
+        }
+    }
+
+    /// <summary>drape_garment_stats (72 bytes): what the garment's last step did.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct GarmentStats
+    {
+        /// <summary>struct_size: sizeof(drape_garment_stats); set by the reading method.</summary>
+        public uint StructSize;
+        /// <summary>particles.</summary>
+        public uint Particles;
+        /// <summary>attached: particles pinned to body rings.</summary>
+        public uint Attached;
+        /// <summary>substeps: in the last step (blend-in frames included).</summary>
+        public uint Substeps;
+        /// <summary>blend_frames: extra 1/30 s frames the last step ran to blend a new pose in.</summary>
+        public uint BlendFrames;
+        /// <summary>contacts: particle-ellipsoid corrections in the last step.</summary>
+        public uint Contacts;
+        /// <summary>swept_catches: of which caught by the swept test.</summary>
+        public uint SweptCatches;
+        /// <summary>escapes: particles squeezed between overlapping ellipsoids.</summary>
+        public uint Escapes;
+        /// <summary>steps (uint64_t): steps so far.</summary>
+        public ulong Steps;
+        /// <summary>teleport_reset (uint8_t): 1 if the last step carried the garment across a teleport.</summary>
+        public byte TeleportReset;
+        /// <summary>nan_reset (uint8_t): 1 if the last step had to restore the garment (please report).</summary>
+        public byte NanReset;
+        /// <summary>reserved0.</summary>
+        public byte Reserved0;
+        /// <summary>reserved1.</summary>
+        public byte Reserved1;
+        /// <summary>reserved2.</summary>
+        public uint Reserved2;
+        /// <summary>step_ms: wall time of the garment's last step.</summary>
+        public double StepMs;
+        /// <summary>collide_ms: of which ellipsoid collision.</summary>
+        public double CollideMs;
+        /// <summary>integrate_ms: the rest (integration and constraints).</summary>
+        public double IntegrateMs;
+
+        /// <summary><see cref="TeleportReset"/> as a bool.</summary>
+        public bool IsTeleportReset => TeleportReset != 0;
+        /// <summary><see cref="NanReset"/> as a bool.</summary>
+        public bool IsNanReset => NanReset != 0;
+    }
+
+    /// <summary>drape_garment_accuracy (32 bytes): how accurate the garment is now (a diagnostic,
+    /// about 1 ms per 1 000 particles).</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct GarmentAccuracy
+    {
+        /// <summary>struct_size: sizeof(drape_garment_accuracy); set by the reading method.</summary>
+        public uint StructSize;
+        /// <summary>proxy_inside: particles inside an ellipsoid they collide with, by more than 0.1 mm.</summary>
+        public uint ProxyInside;
+        /// <summary>max_stretch: structural edges, max of |len| / rest - 1.</summary>
+        public float MaxStretch;
+        /// <summary>p99_stretch: its 99th percentile.</summary>
+        public float P99Stretch;
+        /// <summary>mean_stretch.</summary>
+        public float MeanStretch;
+        /// <summary>body_penetration_p99_mm: depth of vertices inside the body mesh (0 before an update).</summary>
+        public float BodyPenetrationP99Mm;
+        /// <summary>body_penetration_max_mm.</summary>
+        public float BodyPenetrationMaxMm;
+        /// <summary>deeper_than_2mm: fraction of vertices more than 2 mm inside the body.</summary>
+        public float DeeperThan2mm;
     }
 }

@@ -442,12 +442,18 @@ DRAPE_API drape_result DRAPE_CALL drape_context_add_garment_template(drape_conte
                                                                      const drape_cloth_params* cloth,
                                                                      drape_garment** out_garment);
 
+typedef enum drape_mesh_facing {
+  DRAPE_MESH_FACING_PLUS_Z = 0,  /* the character faces +Z (MakeHuman, Blender's glTF export) */
+  DRAPE_MESH_FACING_MINUS_Z = 1, /* faces -Z, subject's right at +X: Drape's own frame */
+  DRAPE_MESH_FACING_FORCE32 = 0x7fffffff
+} drape_mesh_facing;
+
 /* How a garment mesh made for another body is placed on this one (docs/garment-obj.md). The
  * defaults fit MakeHuman garments (decimetres, facing +Z, A-pose, 1.60 m / 46.3 kg base mesh). */
 typedef struct drape_mesh_fit {
   uint32_t struct_size;        /* sizeof(drape_mesh_fit), set by drape_mesh_fit_init */
   float unit_scale;            /* metres per mesh unit, [0, 1000]; 0 = detect (1, 0.1, 0.01, 0.001) */
-  int32_t facing;              /* 0: the character faces +Z (MakeHuman, Blender glTF), 1: -Z (Drape) */
+  int32_t facing;              /* drape_mesh_facing; DRAPE_MESH_FACING_PLUS_Z */
   float source_height_m;       /* the body the mesh was made for, [0.8, 2.5]; 1.60 */
   float source_weight_kg;      /* [15, 300]; 46.3 (docs/garment-obj.md) */
   float source_floor_y_m;      /* where that body's feet are, after scaling, [-100, 100]; -0.82 */
@@ -463,7 +469,9 @@ DRAPE_API drape_result DRAPE_CALL drape_mesh_fit_init(drape_mesh_fit* fit);
 
 /* Adds a garment from a Wavefront OBJ file (UTF-8 path) or OBJ text in memory (copied): faces of
  * 3+ vertices, split into triangles; retargeted onto the body's rings and attached at its top
- * boundary loops (docs/garment-obj.md). fit, desc and cloth may be NULL for defaults. */
+ * boundary loops (docs/garment-obj.md); a garment with no such loop (a patch, a decoration) is
+ * added unattached and rests on the body by collision (drape_garment_stats.attached tells). fit,
+ * desc and cloth may be NULL for defaults. */
 DRAPE_API drape_result DRAPE_CALL drape_context_add_garment_obj_file(drape_context* context,
                                                                      const char* path,
                                                                      const drape_mesh_fit* fit,
@@ -492,9 +500,11 @@ DRAPE_API drape_result DRAPE_CALL drape_context_add_garment_mesh(drape_context* 
  * accepted and ignored. */
 DRAPE_API drape_result DRAPE_CALL drape_garment_destroy(drape_garment* garment);
 
-/* Replaces the cloth parameters (validated as a whole; on failure nothing changes). */
+/* Replaces the cloth parameters (validated as a whole; on failure nothing changes). Calls on a
+ * garment count as calls on its context (one thread per context). */
 DRAPE_API drape_result DRAPE_CALL drape_garment_set_params(drape_garment* garment,
                                                            const drape_cloth_params* params);
+/* `out_params->struct_size` must be set by the caller (drape_cloth_params_init does). */
 DRAPE_API drape_result DRAPE_CALL drape_garment_get_params(drape_garment* garment,
                                                            drape_cloth_params* out_params);
 

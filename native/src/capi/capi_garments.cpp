@@ -354,10 +354,9 @@ DRAPE_API drape_result DRAPE_CALL drape_context_add_garment_obj_file(drape_conte
     if (drape_result r = readCommon(fn, desc, cloth, d, sim)) return r;
     drape::ObjMesh obj;
     std::string err;
-    if (!drape::readObjFile(path, obj, err)) {
-      const bool io = err.find("open") != std::string::npos || err.find("read") != std::string::npos;
+    bool io = false;
+    if (!drape::readObjFile(path, obj, err, &io))
       return fail(io ? DRAPE_ERROR_IO : DRAPE_ERROR_PARSE, std::string(fn) + ": " + err);
-    }
     return addFitted(fn, *ctx, obj, fit, d, sim, out_garment);
   });
 }
@@ -569,3 +568,4 @@ static_assert(sizeof(drape_garment_template) == 24, "drape_garment_template layo
 static_assert(sizeof(drape_mesh_fit) == 48, "drape_mesh_fit layout");
 static_assert(sizeof(drape_garment_stats) == 72, "drape_garment_stats layout");
 static_assert(sizeof(drape_garment_accuracy) == 32, "drape_garment_accuracy layout");
+static_assert(sizeof(drape_cloth_params) == 124, "drape_cloth_params layout");

@@ -3,12 +3,14 @@
 #include "cloth/garment_obj.h"
 
 #include "body/body_shape.h"
+#include "cloth/ring_skin.h"
 
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <limits>
@@ -168,17 +170,29 @@ bool parseObj(const char* text, size_t size, ObjMesh& out, std::string& err) {
   return true;
 }
 
-bool readObjFile(const std::string& path, ObjMesh& out, std::string& err) {
+bool readObjFile(const std::string& path, ObjMesh& out, std::string& err, bool* io_error) {
+  if (io_error) *io_error = true;
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    err = "cannot read '" + path + "': it is a directory";
+    return false;
+  }
   std::ifstream f(path, std::ios::binary);
   if (!f) {
     err = "cannot open '" + path + "': " + std::strerror(errno);
     return false;
   }
-  const std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  std::string text;
+  try {
+    text.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+  } catch (const std::ios_base::failure&) {
+    f.setstate(std::ios::badbit);
+  }
   if (f.bad()) {
     err = "cannot read '" + path + "'";
     return false;
   }
+  if (io_error) *io_error = false;
   if (parseObj(text.data(), text.size(), out, err)) return true;
   err = path + ": " + err;
   return false;
@@ -187,58 +201,6 @@ bool readObjFile(const std::string& path, ObjMesh& out, std::string& err) {
 // ---- Fitting --------------------------------------------------------------------------------
 
 namespace {
-
-// The body between rings r0 and r0 + 1 of one chain at parameter t, interpolated as the garment
-// templates interpolate their sections.
-struct Section {
-  Vec3 c;
-  Mat3 f;
-  float a, b;  // semi-axes along the frame's x (forward) and z
-};
-
-Section sectionAt(const std::vector<RingPose>& rings, int r0, float t) {
-  const RingPose& A = rings[r0];
-  const RingPose& B = rings[r0 + 1];
-  const float s = 1.0f - t;
-  const Vec3 y = (s * A.frame.col(1) + t * B.frame.col(1)).normalized();
-  const Vec3 x0 = s * A.frame.col(0) + t * B.frame.col(0) - (s * A.frame.col(0) + t * B.frame.col(0)).dot(y) * y;
-  const Vec3 x = x0.norm() > 1e-6f ? Vec3(x0.normalized()) : anyPerpendicular(y);
-  Mat3 f;
-  f << x, y, x.cross(y);
-  return {s * A.centre + t * B.centre, f, s * A.forward_m + t * B.forward_m, s * A.side_m + t * B.side_m};
-}
-
-// A vertex in ring space: x and z as fractions of the section's semi-axes (so it scales with the
-// girth), y along the chain in metres. `dist` approximates the distance to the body surface
-// (negative inside): the radial excess over the ellipse, combined with any overshoot past the
-// segment's ends (t is clamped to the segment, so past a chain's end y carries the overshoot).
-struct Binding {
-  int chain = 0, r0 = 0;
-  float t = 0.0f, dist = 0.0f;
-  Vec3 local = Vec3::Zero();
-};
-
-Binding bindTo(const std::vector<RingPose>& rings, int chain, int r0, const Vec3& p) {
-  const Vec3 c0 = rings[r0].centre, d = rings[r0 + 1].centre - c0;
-  const float dd = d.squaredNorm();
-  Binding b;
-  b.chain = chain;
-  b.r0 = r0;
-  b.t = dd > 1e-12f ? std::clamp((p - c0).dot(d) / dd, 0.0f, 1.0f) : 0.0f;
-  const Section s = sectionAt(rings, r0, b.t);
-  const Vec3 q = s.f.transpose() * (p - s.c);
-  const float nx = q.x() / s.a, nz = q.z() / s.b;
-  const float rho = std::hypot(nx, nz), radial = std::hypot(q.x(), q.z());
-  const float surf = rho > 1e-6f ? radial * (1.0f - 1.0f / rho) : -std::min(s.a, s.b);
-  b.dist = std::hypot(std::max(surf, 0.0f), q.y()) + std::min(surf, 0.0f);
-  b.local = Vec3(nx, q.y(), nz);
-  return b;
-}
-
-Vec3 evaluate(const std::vector<RingPose>& rings, const Binding& b) {
-  const Section s = sectionAt(rings, b.r0, b.t);
-  return s.c + s.f * Vec3(b.local.x() * s.a, b.local.y(), b.local.z() * s.b);
-}
 
 bool sameLayout(const BodyModel& a, const BodyModel& b) {
   if (a.stations().size() != b.stations().size()) return false;
@@ -310,7 +272,7 @@ SkeletonPose sourcePose(const ResolvedShape& shape, const ObjFitParams& p) {
 // undirected graph: the elegant suit's lapel has a flipped face beside a pinch vertex, which
 // breaks a walk along face directions.
 std::vector<std::vector<uint32_t>> attachmentLoops(const std::vector<uint32_t>& I, const std::vector<Vec3>& src,
-                                                   const std::vector<Binding>& primary) {
+                                                   const std::vector<RingBinding>& primary) {
   const size_t nv = src.size();
   std::vector<uint64_t> keys;
   keys.reserve(I.size());
@@ -367,8 +329,8 @@ std::vector<std::vector<uint32_t>> attachmentLoops(const std::vector<uint32_t>& 
     size_t onTrunk = 0;
     float turn = 0.0f, meanY = 0.0f;
     for (size_t i = 0; i < loop.size(); ++i) {
-      const Binding& a = primary[loop[i]];
-      const Binding& b = primary[loop[(i + 1) % loop.size()]];
+      const RingBinding& a = primary[loop[i]];
+      const RingBinding& b = primary[loop[(i + 1) % loop.size()]];
       onTrunk += a.chain == int(Chain::Torso) || a.chain == int(Chain::Head);
       float d = std::atan2(b.local.z(), b.local.x()) - std::atan2(a.local.z(), a.local.x());
       turn += d - 2.0f * kPi * std::round(d / (2.0f * kPi));
@@ -461,42 +423,23 @@ bool fitObjGarment(const ObjMesh& mesh, const ObjFitParams& p, const BodyModel& 
   }
   BodyModel source(shape, bp);
   source.update(sourcePose(shape, p));
-  const std::vector<RingPose>& S = source.rings();
   const std::vector<RingPose>& T = target.rings();
 
   // The nearest segment (primary binding) decides attachments; the position blends every segment
   // nearly as near, each of which maps the vertex exactly onto itself on the source body.
   const size_t nv = src.size();
   GarmentMesh g;
-  g.positions.resize(nv);
   g.indices = mesh.indices;
-  std::vector<Binding> primary(nv), cands;
-  for (size_t v = 0; v < nv; ++v) {
-    cands.clear();
-    for (int c = 0; c < kChainCount; ++c) {
-      const int first = source.chainFirstRing(Chain(c)), n = source.chainRingCount(Chain(c));
-      for (int i = 0; i + 1 < n; ++i) cands.push_back(bindTo(S, c, first + i, src[v]));
-    }
-    primary[v] = *std::min_element(cands.begin(), cands.end(),
-                                   [](const Binding& a, const Binding& b) { return a.dist < b.dist; });
-    Vec3 sum = evaluate(T, primary[v]);
-    float wsum = 1.0f;
-    if (p.blend_m > 0.0f) {
-      sum = Vec3::Zero();
-      wsum = 0.0f;
-      for (const Binding& b : cands) {
-        const float w = std::exp(-(b.dist - primary[v].dist) / p.blend_m);
-        if (w < 0.018f) continue;  // beyond 4 widths
-        sum += w * evaluate(T, b);
-        wsum += w;
-      }
-    }
-    g.positions[v] = sum / wsum;
-    if (!isFinite(g.positions[v])) {
+  RingSkin skin;
+  skin.bind(source, src, p.blend_m);
+  skin.place(target, g.positions);
+  for (const Vec3& x : g.positions) {
+    if (!isFinite(x)) {
       err = "fit produced a non-finite position";
       return false;
     }
   }
+  const std::vector<RingBinding>& primary = skin.primaries();
   std::vector<char> isPinned(nv, 0);
   for (const std::vector<uint32_t>& loop : attachmentLoops(mesh.indices, src, primary)) {
     for (uint32_t v : loop) {

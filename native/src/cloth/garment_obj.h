@@ -32,7 +32,9 @@ struct ObjMesh {
 // corner). vt, vn, vp, o, g, s, l, p, usemtl, mtllib, comments, blank lines and CRLF endings are
 // ignored; any other statement is an error. Errors name the 1-based line.
 bool parseObj(const char* text, size_t size, ObjMesh& out, std::string& err);
-bool readObjFile(const std::string& path, ObjMesh& out, std::string& err);
+// io_error (optional) tells a file that could not be read (missing, a directory) from one that
+// is not valid OBJ.
+bool readObjFile(const std::string& path, ObjMesh& out, std::string& err, bool* io_error = nullptr);
 
 // Which way the character in the file faces (+Y is up in both).
 enum class ObjFacing : int {

@@ -18,16 +18,10 @@ double msSince(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-// Frames of blend-in and of dressing run at this rate (the recording rate of a Kinect).
+// Frames of settling and of dressing run at this rate (the recording rate of a Kinect).
 constexpr float kSettleFrameS = 1.0f / 30.0f;
-
-Ellipsoid moved(const Ellipsoid& e, const Mat3& R, const Vec3& pivot, const Vec3& t) {
-  Ellipsoid m = e;
-  m.centre = R * (e.centre - pivot) + pivot + t;
-  m.rotation = R * e.rotation;
-  m.refresh();
-  return m;
-}
+// Soft choice of skinning segment (as the OBJ fit's default): see cloth/ring_skin.h.
+constexpr float kSkinBlendM = 0.015f;
 
 Mat3 partialRotation(const Mat3& R, float fraction) {
   Quat q(R);
@@ -194,8 +188,8 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
 
   g->pelvis_ring_ = body_rest.chainFirstRing(Chain::Torso);
   const RingPose& pr = body_rest.rings()[static_cast<size_t>(g->pelvis_ring_)];
-  g->rest_pelvis_c_ = g->seen_pelvis_c_ = pr.centre;
-  g->rest_pelvis_f_ = g->seen_pelvis_f_ = pr.frame;
+  g->seen_pelvis_c_ = pr.centre;
+  g->seen_pelvis_f_ = pr.frame;
   g->seen_ellipsoids_ = rest_ellipsoids;
   g->pinTargets(body_rest, g->seen_pins_);
 
@@ -219,6 +213,7 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
       return nullptr;
     }
   }
+  g->skin_.bind(body_rest, g->dressed_, kSkinBlendM);
   g->last_ = GarmentStepStats{};
   return g;
 }
@@ -304,40 +299,16 @@ void GarmentSim::carry(const Mat3& R, const Vec3& pivot, const Vec3& t, float ve
   solver_->transform(R, pivot, t, velocity_scale);
 }
 
-// The body jumped (first tracked frame, teleport): carry the garment rigidly with the pelvis, then
-// move the body from the carried old pose to the new one over blend_in_s, so limbs sweep the
-// garment into place instead of appearing inside it.
-void GarmentSim::blendIn(const BodyModel& body, const std::vector<Ellipsoid>& end) {
-  const RingPose& pr = body.rings()[static_cast<size_t>(pelvis_ring_)];
-  const Mat3 R = pr.frame * seen_pelvis_f_.transpose();
-  const Vec3 t = pr.centre - seen_pelvis_c_;
-  carry(R, seen_pelvis_c_, t, 0.0f);
-  ell_a_.resize(seen_ellipsoids_.size());
-  for (size_t k = 0; k < ell_a_.size(); ++k) ell_a_[k] = moved(seen_ellipsoids_[k], R, seen_pelvis_c_, t);
-  pins_a_.resize(seen_pins_.size());
-  for (size_t k = 0; k < pins_a_.size(); ++k) pins_a_[k] = R * (seen_pins_[k] - seen_pelvis_c_) + seen_pelvis_c_ + t;
-  pinTargets(body, pins_b_);
-  const int frames = static_cast<int>(std::ceil(params_.blend_in_s / kSettleFrameS - 1e-4f));
-  std::vector<Ellipsoid>& from = ell_b_;
-  from = ell_a_;
-  for (int f = 1; f <= frames; ++f) {
-    const float u = static_cast<float>(f) / static_cast<float>(frames);
-    std::vector<Ellipsoid> to(end.size());
-    for (size_t k = 0; k < to.size(); ++k) to[k] = interpolateEllipsoid(ell_a_[k], end[k], u);
-    for (size_t k = 0; k < pins_.size(); ++k) pins_[k] = pins_a_[k] + u * (pins_b_[k] - pins_a_[k]);
-    runFrame(from, to, pins_, kSettleFrameS);
-    from.swap(to);
-  }
-  last_.blend_frames = frames;
-}
-
-void GarmentSim::resetToDressed(const BodyModel& body) {
-  const RingPose& pr = body.rings()[static_cast<size_t>(pelvis_ring_)];
-  const Mat3 R = pr.frame * rest_pelvis_f_.transpose();
-  scratch3_.resize(dressed_.size());
-  for (size_t i = 0; i < dressed_.size(); ++i) scratch3_[i] = R * (dressed_[i] - rest_pelvis_c_) + pr.centre;
+// The first tracked frame (or a NaN reset): put the dressed garment where the body's rings carry
+// it now, then let it settle on the new pose with the body held still.
+void GarmentSim::placeOnBody(const BodyModel& body, const std::vector<Ellipsoid>& ellipsoids) {
+  skin_.place(body, scratch3_);
   std::string err;
   solver_->reset(scratch3_, err);
+  pinTargets(body, pins_);
+  const int frames = static_cast<int>(std::ceil(params_.blend_in_s / kSettleFrameS - 1e-4f));
+  for (int f = 0; f < frames; ++f) runFrame(ellipsoids, ellipsoids, pins_, kSettleFrameS);
+  last_.blend_frames = frames;
 }
 
 void GarmentSim::step(const BodyModel& body, const std::vector<Ellipsoid>& start,
@@ -346,10 +317,14 @@ void GarmentSim::step(const BodyModel& body, const std::vector<Ellipsoid>& start
   last_ = GarmentStepStats{};
   pins_.resize(mesh_.pinned.size());
   const RingPose& pr = body.rings()[static_cast<size_t>(pelvis_ring_)];
-  if (!tracked_ || teleported) {
-    last_.teleport_reset = tracked_;
-    blendIn(body, end);
+  if (!tracked_) {
+    placeOnBody(body, end);
     tracked_ = true;
+    runFrame(end, end, pins_, dt);
+  } else if (teleported) {
+    // The person is somewhere else in the same pose: move the garment with them, at rest.
+    last_.teleport_reset = true;
+    carry(pr.frame * seen_pelvis_f_.transpose(), seen_pelvis_c_, pr.centre - seen_pelvis_c_, 0.0f);
     pinTargets(body, pins_);
     runFrame(end, end, pins_, dt);
   } else {
@@ -366,7 +341,7 @@ void GarmentSim::step(const BodyModel& body, const std::vector<Ellipsoid>& start
   const Eigen::Vector4f* x = solver_->x();
   for (size_t i = 0; i < particleCount(); ++i) {
     if (!x[i].allFinite()) {
-      resetToDressed(body);
+      placeOnBody(body, end);
       last_.nan_reset = true;
       break;
     }

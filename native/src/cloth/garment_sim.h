@@ -6,8 +6,9 @@
 //  - a dressing pass at creation: pushed outside the ellipsoids of the rest pose, then settled;
 //  - inertia scaling: a fraction of the body's rigid motion (pelvis ring) carries the garment
 //    directly instead of through constraints (as NvCloth / Unity Cloth / Chaos do);
-//  - teleports and the first tracked frame: the garment is carried with the body and the body's
-//    pose is blended in from where the garment last saw it, so nothing stretches across the room;
+//  - the first tracked frame: the dressed garment is placed on the tracked pose by ring skinning
+//    (cloth/ring_skin.h) and settles there; a teleport carries it rigidly with the pelvis ring,
+//    so nothing stretches across the room;
 //  - a NaN guard: a non-finite result restores the dressed shape carried to the current body.
 // Host frame times vary: a step of dt runs ceil(dt * substep_hz) substeps (capped).
 // Method and figures: docs/garments.md. Nothing throws except std::bad_alloc.
@@ -18,6 +19,7 @@
 #include "cloth/garment_templates.h"
 #include "cloth/garment_topology.h"
 #include "cloth/mass_spring_solver.h"
+#include "cloth/ring_skin.h"
 #include "cloth/xpbd_solver.h"
 #include "proxies/collision.h"
 #include "proxies/mesh_bvh.h"
@@ -39,14 +41,15 @@ struct GarmentSimParams {
   float collision_margin_m = EllipsoidCollider::kDefaultMargin;  // cloth thickness, [0, 0.05]
   float linear_inertia = 0.5f;  // [0, 1]: 1 = physical, 0 = carried rigidly with the pelvis
   float angular_inertia = 0.5f; // [0, 1]: the same for the pelvis' rotation
-  float blend_in_s = 0.3f;      // first frame / teleport: pose blended in over this, [0, 2]
+  float blend_in_s = 0.3f;      // first frame: settling time after the garment is placed on the
+                                // tracked pose by ring skinning, [0, 2]
 };
 // Empty string when valid, else what is wrong.
 std::string validate(const GarmentSimParams& p);
 
 struct GarmentStepStats {
   int substeps = 0;
-  int blend_frames = 0;          // extra frames run to blend a new pose in (first frame, teleport)
+  int blend_frames = 0;          // extra frames run to settle on a new pose (first frame, teleport)
   double total_ms = 0.0;         // wall time of the step
   double collide_ms = 0.0;       // of which in the ellipsoid collision
   CollisionStats collision;      // summed over the substeps
@@ -124,8 +127,8 @@ class GarmentSim {
   void runFrame(const std::vector<Ellipsoid>& start, const std::vector<Ellipsoid>& end,
                 const std::vector<Vec3>& pins, float dt);
   void carry(const Mat3& R, const Vec3& pivot, const Vec3& t, float velocity_scale);
-  void blendIn(const BodyModel& body, const std::vector<Ellipsoid>& end);
-  void resetToDressed(const BodyModel& body);
+  // Places the dressed garment on `body` by skinning and settles it for blend_in_s.
+  void placeOnBody(const BodyModel& body, const std::vector<Ellipsoid>& ellipsoids);
 
   GarmentMesh mesh_;
   GarmentTopology topology_;
@@ -143,14 +146,12 @@ class GarmentSim {
   std::vector<Vec3> seen_pins_;
   bool tracked_ = false;  // false until the first step (the garment still sits on the rest pose)
 
-  // The dressed shape on the rest pose and that pose's pelvis ring, for NaN resets.
+  // The dressed shape on the rest pose, bound to the rest body's rings.
   std::vector<Vec3> dressed_;
-  Vec3 rest_pelvis_c_ = Vec3::Zero();
-  Mat3 rest_pelvis_f_ = Mat3::Identity();
+  RingSkin skin_;
 
   // Per-step scratch (sized once).
-  std::vector<Vec3> pins_, pins_a_, pins_b_, scratch3_;
-  std::vector<Ellipsoid> ell_a_, ell_b_;
+  std::vector<Vec3> pins_, scratch3_;
   GarmentStepStats last_;
   uint64_t steps_ = 0;
 };

@@ -444,6 +444,62 @@ class Builder {
   std::vector<float> scale_;
 };
 
+// Where two stitched loops meet (armhole zips, the crotch bridge) the stitch can leave edges far
+// shorter than the mesh spacing (0.1 mm next to 2 cm ones). Such an edge has no say in the shape,
+// but measured as stretch over its rest length it dominates every maximum, and its tiny mass
+// stiffens the solve. Merge the ends of every edge shorter than `tol` (union-find, the lower
+// index survives; a pinned end stays pinned) and drop triangles that collapse.
+void weldShortEdges(GarmentMesh& m, float tol) {
+  const size_t n = m.positions.size();
+  std::vector<uint32_t> parent(n);
+  for (uint32_t i = 0; i < n; ++i) parent[i] = i;
+  auto root = [&](uint32_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  const float tol2 = tol * tol;
+  bool any = false;
+  for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
+    for (size_t e = 0; e < 3; ++e) {
+      const uint32_t a = m.indices[t + e], b = m.indices[t + (e + 1) % 3];
+      if ((m.positions[a] - m.positions[b]).squaredNorm() >= tol2) continue;
+      const uint32_t ra = root(a), rb = root(b);
+      if (ra == rb) continue;
+      parent[std::max(ra, rb)] = std::min(ra, rb);
+      any = true;
+    }
+  }
+  if (!any) return;
+  // Survivors that still have a triangle, renumbered in order.
+  std::vector<uint32_t> tris;
+  for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
+    const uint32_t a = root(m.indices[t]), b = root(m.indices[t + 1]), c = root(m.indices[t + 2]);
+    if (a == b || b == c || c == a) continue;
+    tris.insert(tris.end(), {a, b, c});
+  }
+  std::vector<uint32_t> remap(n, UINT32_MAX);
+  GarmentMesh out;
+  for (uint32_t v : tris) {
+    if (remap[v] != UINT32_MAX) continue;
+    remap[v] = 0;  // mark used
+  }
+  for (uint32_t i = 0; i < n; ++i) {
+    if (remap[i] == UINT32_MAX) continue;
+    remap[i] = static_cast<uint32_t>(out.positions.size());
+    out.positions.push_back(m.positions[i]);
+  }
+  for (uint32_t v : tris) out.indices.push_back(remap[v]);
+  std::vector<char> pinned(out.positions.size(), 0);
+  for (size_t k = 0; k < m.pinned.size(); ++k) {
+    const uint32_t r = root(m.pinned[k]);
+    if (remap[r] == UINT32_MAX || pinned[remap[r]]) continue;
+    pinned[remap[r]] = 1;
+    out.pinned.push_back(remap[r]);
+    out.pin_ring.push_back(m.pin_ring[k]);
+  }
+  m = std::move(out);
+}
+
 }  // namespace
 
 const char* garmentKindName(GarmentKind kind) {
@@ -503,6 +559,7 @@ bool makeGarmentTemplate(const BodyModel& body, const GarmentTemplateParams& p, 
     h *= std::clamp(std::sqrt(n / target), 0.7f, 1.4f);
   }
   builder.pushOut(mesh, EllipsoidCollider::kDefaultMargin + 0.002f);
+  weldShortEdges(mesh, 0.25f * h);
   builder.finishPins(mesh);
   for (const Vec3& x : mesh.positions) {
     if (!x.allFinite()) {

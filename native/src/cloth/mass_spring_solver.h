@@ -65,6 +65,8 @@ class MassSpringSolver {
   const GarmentTopology& topology() const { return topology_; }
   size_t particleCount() const { return x_.size(); }
   const Eigen::Vector4f* positions() const { return x_.data(); }   // w = inverse mass
+  // Writable xyz for callers that constrain particles between steps (keep w as it is).
+  Eigen::Vector4f* mutablePositions() { return x_.data(); }
   const Eigen::Vector4f* velocities() const { return v_.data(); }
 
  private:
