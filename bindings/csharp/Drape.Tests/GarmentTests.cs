@@ -60,6 +60,16 @@ namespace Drape.Tests
                 Assert.InRange(Length(normals[i]), 0.99f, 1.01f);
             }
             foreach (uint index in indices) Assert.True(index < (uint)g.VertexCount, $"index {index} >= {g.VertexCount}");
+            // The rest shape: finite, and no edge of it has zero length.
+            var rest = new Vector3f[g.VertexCount];
+            g.ReadRestPositions(rest);
+            for (int t = 0; t < indices.Length; t += 3)
+                for (int e = 0; e < 3; ++e)
+                {
+                    Vector3f a = rest[indices[t + e]], b = rest[indices[t + (e + 1) % 3]];
+                    Assert.True(a.IsFinite);
+                    Assert.True(Length(new Vector3f(a.X - b.X, a.Y - b.Y, a.Z - b.Z)) > 0f);
+                }
 
             // The combined read gives the same arrays.
             var p2 = new Vector3f[g.VertexCount];
@@ -300,6 +310,7 @@ namespace Drape.Tests
             void ExpectTooSmall(Action a) => Assert.Equal(ResultCode.BufferTooSmall, Assert.Throws<DrapeException>(a).Code);
             ExpectTooSmall(() => g.ReadPositions(shortV));
             ExpectTooSmall(() => g.ReadNormals(shortV));
+            ExpectTooSmall(() => g.ReadRestPositions(shortV));
             ExpectTooSmall(() => g.ReadIndices(shortI));
             ExpectTooSmall(() => g.ReadPositions(Span<Vector3f>.Empty));
             ExpectTooSmall(() => g.ReadNormals(Span<Vector3f>.Empty));

@@ -149,6 +149,16 @@ namespace Drape
                     h, p != null ? p : &none, null, (uint)positions.Length, null, 0));
         }
 
+        /// <summary>Copies the garment's rest shape (every edge at its rest length; fixed for the
+        /// garment) into <paramref name="positions"/>, at least <see cref="VertexCount"/> long.</summary>
+        public void ReadRestPositions(Span<Vector3f> positions)
+        {
+            IntPtr h = Live;
+            Vector3f none;
+            fixed (Vector3f* p = positions)
+                DrapeException.Check(Native.drape_garment_read_rest_positions(h, p != null ? p : &none, (uint)positions.Length));
+        }
+
         /// <summary>Computes and copies unit vertex normals (area-weighted) into
         /// <paramref name="normals"/>, at least <see cref="VertexCount"/> long.</summary>
         public void ReadNormals(Span<Vector3f> normals)

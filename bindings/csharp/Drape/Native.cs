@@ -184,6 +184,10 @@ namespace Drape
         internal static extern ResultCode drape_garment_read_mesh(IntPtr garment, Vector3f* positions, Vector3f* normals,
                                                                   uint vertexCapacity, uint* indices, uint indexCapacity);
 
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_garment_read_rest_positions(IntPtr garment, Vector3f* positions,
+                                                                            uint vertexCapacity);
+
         /// <param name="garment">drape_garment*.</param>
         /// <param name="outXyzw">receives a library-owned pointer to vertex_count float4 (x, y, z, inverse mass).</param>
         /// <param name="outVertexCount">optional.</param>

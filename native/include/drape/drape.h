@@ -529,6 +529,12 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_read_mesh(drape_garment* garment
                                                           uint32_t* indices,
                                                           uint32_t index_capacity);
 
+/* The garment's rest shape (the cut: every edge at its rest length), vertex_capacity >= the
+ * vertex count, in the same order as drape_garment_read_mesh. For measuring stretch. */
+DRAPE_API drape_result DRAPE_CALL drape_garment_read_rest_positions(drape_garment* garment,
+                                                                    drape_vec3* positions,
+                                                                    uint32_t vertex_capacity);
+
 /* Borrowed view of the particle positions, no copy: *out_xyzw points at vertex_count float4
  * (x, y, z in metres, w = inverse mass, 0 for attached particles), owned by the library and valid
  * until the next drape_context_step, drape_garment_set_params, drape_garment_destroy or

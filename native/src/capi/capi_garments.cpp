@@ -501,6 +501,21 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_read_mesh(drape_garment* handle,
   });
 }
 
+DRAPE_API drape_result DRAPE_CALL drape_garment_read_rest_positions(drape_garment* handle, drape_vec3* positions,
+                                                                    uint32_t vertex_capacity) {
+  static const char* fn = "drape_garment_read_rest_positions";
+  return guarded(fn, [&]() -> drape_result {
+    DRAPE_CHECK_GARMENT("drape_garment_read_rest_positions", handle);
+    if (!positions) return fail(DRAPE_ERROR_NULL_ARGUMENT, std::string(fn) + ": positions is NULL");
+    const std::vector<drape::Vec3>& rest = garment->topology().rest_positions;
+    if (vertex_capacity < rest.size())
+      return fail(DRAPE_ERROR_BUFFER_TOO_SMALL, std::string(fn) + ": vertex_capacity " + std::to_string(vertex_capacity) +
+                                                    " < " + std::to_string(rest.size()));
+    for (size_t i = 0; i < rest.size(); ++i) positions[i] = c3(rest[i]);
+    return DRAPE_OK;
+  });
+}
+
 DRAPE_API drape_result DRAPE_CALL drape_garment_view_positions(drape_garment* handle, const float** out_xyzw,
                                                                uint32_t* out_vertex_count) {
   return guarded("drape_garment_view_positions", [&]() -> drape_result {
