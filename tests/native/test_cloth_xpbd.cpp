@@ -171,6 +171,51 @@ TEST(ClothXpbd, CollidesWithAnEllipsoid) {
   EXPECT_GT(s.lastCollisionStats().contacts, 0u);
 }
 
+TEST(ClothXpbd, ParamsAndStepSizeChangesTakeEffect) {
+  // The solver caches 1 / (w_a + w_b + alpha / h^2) per constraint; a new compliance (setParams)
+  // and new substep lengths must be picked up: the run stays finite and deterministic, and the
+  // softer compliance really changes the result.
+  auto run = [](bool switch_midway) {
+    XpbdSolver s(square(12, true));
+    std::string error;
+    XpbdParams p;
+    for (int f = 0; f < 20; ++f) {
+      if (switch_midway && f == 10) {
+        p.bend_compliance = 1e-1f;
+        p.stretch_compliance = 1e-6f;
+        EXPECT_TRUE(s.setParams(p, error));
+      }
+      EXPECT_TRUE(s.step(f < 15 ? 1.0f / 60.0f : 1.0f / 30.0f, f < 5 ? 10 : 7));
+    }
+    return std::vector<Eigen::Vector4f>(s.positions(), s.positions() + s.particleCount());
+  };
+  const std::vector<Eigen::Vector4f> a = run(true), b = run(true), c = run(false);
+  ASSERT_EQ(a.size(), 144u);
+  EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(Eigen::Vector4f)), 0);
+  EXPECT_NE(std::memcmp(a.data(), c.data(), a.size() * sizeof(Eigen::Vector4f)), 0);  // softer: it changed
+  for (const Eigen::Vector4f& x : a) EXPECT_TRUE(x.allFinite());
+}
+
+TEST(ClothXpbd, AtRestNothingMovesAndPaddingStaysHidden) {
+  // One triangle (3 constraints: each colour group is padded with inert constraints on a hidden
+  // dummy particle), no gravity, at rest: nothing may move, and the count stays the mesh's.
+  const float pos[] = {0.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f};
+  const uint32_t idx[] = {0, 1, 2};
+  GarmentTopology t;
+  std::string error;
+  ASSERT_TRUE(buildGarmentTopology(pos, 3, idx, 3, TopologyParams{}, t, error)) << error;
+  XpbdSolver s(t);
+  XpbdParams p;
+  p.gravity = Vec3::Zero();
+  p.damping = 0.0f;
+  ASSERT_TRUE(s.setParams(p, error));
+  const Vec3 moved[] = {Vec3(0.0f, 0.0f, 0.0f), Vec3(1.0f, 0.0f, 0.0f), Vec3(0.0f, 1.0f, 0.0f)};
+  ASSERT_TRUE(s.reset(moved, 3, error));
+  ASSERT_TRUE(s.step(1.0f / 60.0f, 1));  // at rest length already: nothing moves
+  for (int i = 0; i < 3; ++i) EXPECT_LT((s.positions()[i].head<3>() - moved[i]).norm(), 1e-6f);
+  EXPECT_EQ(s.particleCount(), 3u);
+}
+
 TEST(ClothXpbd, RejectsBadArgumentsAndChangesNothing) {
   XpbdSolver s(square(8, true));
   const std::vector<Eigen::Vector4f> before(s.positions(), s.positions() + s.particleCount());

@@ -828,5 +828,51 @@ TEST(Collider, DegenerateInputsStayFinite) {
   EXPECT_EQ(col.collide(x.data(), nullptr, 1, CollisionParams{}).tests, 0u);
 }
 
+TEST(Collider, ExactShallowContactsMatchTheReference) {
+  // Contacts with |q| in [0.8, 1) take the float Newton path of the collider (the double solver
+  // only as fallback); the result must be the reference closest point: same distance to 2e-6 of
+  // the largest radius, on the surface, and never a longer push than the radial one.
+  const Ellipsoid shapes[] = {
+      makeEllipsoid(Vec3(0.1f, 1.2f, 0.3f), Vec3(0.05f, 0.15f, 0.05f),
+                    Eigen::AngleAxisf(0.4f, Vec3(1, 2, 0).normalized()).toRotationMatrix()),
+      makeEllipsoid(Vec3(0.0f, 1.0f, 0.0f), Vec3(0.15f, 0.014f, 0.11f)),  // flat torso ring
+      makeEllipsoid(Vec3(-0.2f, 0.5f, 0.1f), Vec3(0.08f, 0.08f, 0.08f)),   // sphere
+      makeEllipsoid(Vec3(0.3f, 0.9f, -0.2f), Vec3(0.12f, 0.07f, 0.03f),
+                    Eigen::AngleAxisf(1.1f, Vec3(0, 1, 1).normalized()).toRotationMatrix())};
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), depth(0.8f, 0.9999f);
+  for (const Ellipsoid& e : shapes) {
+    EllipsoidCollider col;
+    col.setEllipsoids(&e, &e, 1, 0.0f);
+    std::vector<Vec4> pts;
+    while (pts.size() < 5000) {
+      Vec3 q(u(rng), u(rng), u(rng));
+      if (!(q.norm() > 0.1f)) continue;
+      q *= depth(rng) / q.norm();
+      pts.emplace_back(Vec4(0, 0, 0, 1));
+      pts.back().head<3>() = e.fromUnit(q);
+    }
+    std::vector<Vec4> exact = pts;
+    CollisionParams p;
+    p.continuous = false;
+    p.static_friction = p.kinetic_friction = 0.0f;
+    p.response = ContactResponse::Exact;
+    col.collide(exact.data(), nullptr, exact.size(), p);
+    const float r_max = e.radii.maxCoeff();
+    float worst = 0.0f;
+    for (size_t i = 0; i < pts.size(); ++i) {
+      const Vec3 o = pts[i].head<3>();
+      float d_ref = 0.0f;
+      closestPointOnEllipsoid(e.radii, e.rotation.transpose() * (o - e.centre), &d_ref);
+      const float d = (exact[i].head<3>() - o).norm();
+      worst = std::max(worst, std::fabs(d - d_ref));
+      EXPECT_NEAR(d, d_ref, 2e-6f * r_max) << "point " << i;
+      EXPECT_LE(depthInside(e, exact[i].head<3>()), 1e-5f);
+    }
+    std::printf("[ exact    ] radii %.3f %.3f %.3f: 5000 shallow contacts, worst |d - d_ref| = %.2g m\n",
+                e.radii.x(), e.radii.y(), e.radii.z(), worst);
+  }
+}
+
 }  // namespace
 }  // namespace drape

@@ -1,32 +1,266 @@
 #include "cloth/xpbd_solver.h"
 
+#include <chrono>
 #include <cmath>
 #include <utility>
+
+#if defined(__SSE2__) || defined(_M_X64)
+#include <emmintrin.h>
+#define DRAPE_XPBD_SSE 1
+#endif
+#if DRAPE_XPBD_SSE && (defined(__GNUC__) || defined(__clang__)) && (defined(__x86_64__) || defined(__i386__))
+#include <immintrin.h>
+#define DRAPE_XPBD_AVX 1  // an 8-lane AVX kernel, chosen at run time (no FMA: same results)
+#endif
 
 namespace drape {
 namespace {
 
 using Vec4 = Eigen::Vector4f;
+constexpr size_t kLanes = 8;  // groups are padded to this: one AVX batch or two SSE batches
 
 bool finite(const Vec3& v) { return isFinite(v); }
 bool finite(float f) { return std::isfinite(f); }
+
+using Clock = std::chrono::steady_clock;
+double nsBetween(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::nano>(b - a).count();
+}
+
+// Appends the colour groups of `c` to `out`, each padded to a multiple of kLanes with dummy
+// constraints on particle `dummy`.
+void appendPadded(const DistanceConstraints& c, float compliance, uint32_t dummy,
+                  std::vector<uint8_t>* kinds, uint8_t kind,
+                  std::vector<uint32_t>& a, std::vector<uint32_t>& b, std::vector<float>& rest,
+                  std::vector<float>& comp, std::vector<uint32_t>& offsets) {
+  for (size_t g = 0; g < c.colours(); ++g) {
+    for (uint32_t k = c.colour_offsets[g]; k < c.colour_offsets[g + 1]; ++k) {
+      a.push_back(c.a[k]);
+      b.push_back(c.b[k]);
+      rest.push_back(c.rest[k]);
+      comp.push_back(compliance);
+      if (kinds) kinds->push_back(kind);
+    }
+    while (a.size() % kLanes != 0) {
+      a.push_back(dummy);
+      b.push_back(dummy);
+      rest.push_back(0.0f);
+      comp.push_back(0.0f);
+      if (kinds) kinds->push_back(3);
+    }
+    if (a.size() != offsets.back()) offsets.push_back(static_cast<uint32_t>(a.size()));
+  }
+}
+
+#if DRAPE_XPBD_SSE
+// Loads particles i0..i3 (xyzw each) and transposes them to x, y, z, w across the four lanes.
+inline void gather4(const Vec4* x, const uint32_t* idx, __m128& px, __m128& py, __m128& pz,
+                    __m128& pw) {
+  __m128 r0 = _mm_load_ps(x[idx[0]].data()), r1 = _mm_load_ps(x[idx[1]].data());
+  __m128 r2 = _mm_load_ps(x[idx[2]].data()), r3 = _mm_load_ps(x[idx[3]].data());
+  _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+  px = r0; py = r1; pz = r2; pw = r3;
+}
+inline void scatter4(Vec4* x, const uint32_t* idx, __m128 px, __m128 py, __m128 pz, __m128 pw) {
+  _MM_TRANSPOSE4_PS(px, py, pz, pw);
+  _mm_store_ps(x[idx[0]].data(), px);
+  _mm_store_ps(x[idx[1]].data(), py);
+  _mm_store_ps(x[idx[2]].data(), pz);
+  _mm_store_ps(x[idx[3]].data(), pw);
+}
+#endif
+
+// One XPBD iteration (lambda from 0) over a batch list: for each constraint, with
+// C = |d| - rest, d = a - b, and inv_w = 1 / (w_a + w_b + alpha~) (precomputed per step, 0 for
+// padding):  a -= w_a inv_w (C/|d|) d,  b += w_b inv_w (C/|d|) d.
+// Tethers (kTether): only a is written (b is a pinned anchor, w_b = 0), rest is scaled by `scale`
+// and only C > 0 acts (inequality). Constraints of a batch share no particle.
+// 1/|d|: rsqrt estimate + one Newton step (relative error ~1e-7, the size of float rounding in
+// |d| itself): the divider (sqrt + div per batch) was the bottleneck.
+template <bool kTether>
+void projectBatches(Vec4* x, const uint32_t* A, const uint32_t* B, const float* rest,
+                    const float* inv_w, size_t m, float scale) {
+#if DRAPE_XPBD_SSE
+  const __m128 vscale = _mm_set1_ps(scale), zero = _mm_setzero_ps();
+  const __m128 tiny2 = _mm_set1_ps(1e-18f), half = _mm_set1_ps(0.5f), three = _mm_set1_ps(3.0f);
+  const __m128 one = _mm_set1_ps(1.0f);
+  for (size_t k = 0; k < m; k += 4) {
+    __m128 ax, ay, az, aw, bx, by, bz, bw;
+    gather4(x, A + k, ax, ay, az, aw);
+    gather4(x, B + k, bx, by, bz, bw);
+    const __m128 dx = _mm_sub_ps(ax, bx), dy = _mm_sub_ps(ay, by), dz = _mm_sub_ps(az, bz);
+    const __m128 len2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+    const __m128 ok = _mm_cmpgt_ps(len2, tiny2);
+    __m128 y = _mm_rsqrt_ps(len2);
+    y = _mm_mul_ps(_mm_mul_ps(half, y), _mm_sub_ps(three, _mm_mul_ps(len2, _mm_mul_ps(y, y))));
+    const __m128 r = _mm_loadu_ps(rest + k);
+    __m128 s;
+    if (kTether) {
+      const __m128 c = _mm_max_ps(_mm_sub_ps(_mm_mul_ps(len2, y), _mm_mul_ps(r, vscale)), zero);
+      s = _mm_mul_ps(_mm_mul_ps(c, y), _mm_loadu_ps(inv_w + k));
+    } else {
+      s = _mm_mul_ps(_mm_sub_ps(one, _mm_mul_ps(r, y)), _mm_loadu_ps(inv_w + k));
+    }
+    s = _mm_and_ps(ok, s);
+    const __m128 sa = _mm_mul_ps(aw, s);
+    ax = _mm_sub_ps(ax, _mm_mul_ps(sa, dx));
+    ay = _mm_sub_ps(ay, _mm_mul_ps(sa, dy));
+    az = _mm_sub_ps(az, _mm_mul_ps(sa, dz));
+    scatter4(x, A + k, ax, ay, az, aw);
+    if (!kTether) {
+      const __m128 sb = _mm_mul_ps(bw, s);
+      bx = _mm_add_ps(bx, _mm_mul_ps(sb, dx));
+      by = _mm_add_ps(by, _mm_mul_ps(sb, dy));
+      bz = _mm_add_ps(bz, _mm_mul_ps(sb, dz));
+      scatter4(x, B + k, bx, by, bz, bw);
+    }
+  }
+#else
+  for (size_t k = 0; k < m; ++k) {
+    Vec4& pa = x[A[k]];
+    Vec4& pb = x[B[k]];
+    const Vec3 d = pa.head<3>() - pb.head<3>();
+    const float len = std::sqrt(d.squaredNorm());
+    if (!(len > 1e-9f)) continue;
+    const float c = kTether ? std::max(len - rest[k] * scale, 0.0f) : len - rest[k];
+    const float s = c / len * inv_w[k];
+    pa.head<3>() -= (pa.w() * s) * d;
+    if (!kTether) pb.head<3>() += (pb.w() * s) * d;
+  }
+#endif
+}
+
+#if DRAPE_XPBD_AVX
+// The same kernel 8 constraints at a time. Particles i and i+4 share one 256-bit register, so
+// the 4x4 transposes run in-lane (AVX1 shuffles) and cost the same as for 4 constraints.
+__attribute__((target("avx"))) inline __m256 pair8(const Vec4* x, const uint32_t* idx, int i) {
+  return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(x[idx[i]].data())),
+                              _mm_load_ps(x[idx[i + 4]].data()), 1);
+}
+__attribute__((target("avx"))) inline void gather8(const Vec4* x, const uint32_t* idx, __m256& px,
+                                                   __m256& py, __m256& pz, __m256& pw) {
+  const __m256 r0 = pair8(x, idx, 0), r1 = pair8(x, idx, 1), r2 = pair8(x, idx, 2),
+               r3 = pair8(x, idx, 3);
+  const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1);
+  const __m256 t2 = _mm256_unpacklo_ps(r2, r3), t3 = _mm256_unpackhi_ps(r2, r3);
+  px = _mm256_shuffle_ps(t0, t2, 0x44);
+  py = _mm256_shuffle_ps(t0, t2, 0xEE);
+  pz = _mm256_shuffle_ps(t1, t3, 0x44);
+  pw = _mm256_shuffle_ps(t1, t3, 0xEE);
+}
+__attribute__((target("avx"))) inline void scatter8(Vec4* x, const uint32_t* idx, __m256 px,
+                                                    __m256 py, __m256 pz, __m256 pw) {
+  const __m256 t0 = _mm256_unpacklo_ps(px, py), t1 = _mm256_unpackhi_ps(px, py);
+  const __m256 t2 = _mm256_unpacklo_ps(pz, pw), t3 = _mm256_unpackhi_ps(pz, pw);
+  const __m256 r[4] = {_mm256_shuffle_ps(t0, t2, 0x44), _mm256_shuffle_ps(t0, t2, 0xEE),
+                       _mm256_shuffle_ps(t1, t3, 0x44), _mm256_shuffle_ps(t1, t3, 0xEE)};
+  for (int i = 0; i < 4; ++i) {
+    _mm_store_ps(x[idx[i]].data(), _mm256_castps256_ps128(r[i]));
+    _mm_store_ps(x[idx[i + 4]].data(), _mm256_extractf128_ps(r[i], 1));
+  }
+}
+
+template <bool kTether>
+__attribute__((target("avx"))) void projectBatchesAvx(Vec4* x, const uint32_t* A, const uint32_t* B,
+                                                      const float* rest, const float* inv_w,
+                                                      size_t m, float scale) {
+  const __m256 vscale = _mm256_set1_ps(scale), zero = _mm256_setzero_ps();
+  const __m256 tiny2 = _mm256_set1_ps(1e-18f), half = _mm256_set1_ps(0.5f);
+  const __m256 three = _mm256_set1_ps(3.0f), one = _mm256_set1_ps(1.0f);
+  for (size_t k = 0; k < m; k += 8) {
+    __m256 ax, ay, az, aw, bx, by, bz, bw;
+    gather8(x, A + k, ax, ay, az, aw);
+    gather8(x, B + k, bx, by, bz, bw);
+    const __m256 dx = _mm256_sub_ps(ax, bx), dy = _mm256_sub_ps(ay, by), dz = _mm256_sub_ps(az, bz);
+    const __m256 len2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
+                                      _mm256_mul_ps(dz, dz));
+    const __m256 ok = _mm256_cmp_ps(len2, tiny2, _CMP_GT_OQ);
+    __m256 y = _mm256_rsqrt_ps(len2);
+    y = _mm256_mul_ps(_mm256_mul_ps(half, y),
+                      _mm256_sub_ps(three, _mm256_mul_ps(len2, _mm256_mul_ps(y, y))));
+    const __m256 r = _mm256_loadu_ps(rest + k);
+    __m256 s;
+    if (kTether) {
+      const __m256 c = _mm256_max_ps(_mm256_sub_ps(_mm256_mul_ps(len2, y), _mm256_mul_ps(r, vscale)), zero);
+      s = _mm256_mul_ps(_mm256_mul_ps(c, y), _mm256_loadu_ps(inv_w + k));
+    } else {
+      s = _mm256_mul_ps(_mm256_sub_ps(one, _mm256_mul_ps(r, y)), _mm256_loadu_ps(inv_w + k));
+    }
+    s = _mm256_and_ps(ok, s);
+    const __m256 sa = _mm256_mul_ps(aw, s);
+    ax = _mm256_sub_ps(ax, _mm256_mul_ps(sa, dx));
+    ay = _mm256_sub_ps(ay, _mm256_mul_ps(sa, dy));
+    az = _mm256_sub_ps(az, _mm256_mul_ps(sa, dz));
+    scatter8(x, A + k, ax, ay, az, aw);
+    if (!kTether) {
+      const __m256 sb = _mm256_mul_ps(bw, s);
+      bx = _mm256_add_ps(bx, _mm256_mul_ps(sb, dx));
+      by = _mm256_add_ps(by, _mm256_mul_ps(sb, dy));
+      bz = _mm256_add_ps(bz, _mm256_mul_ps(sb, dz));
+      scatter8(x, B + k, bx, by, bz, bw);
+    }
+  }
+}
+
+bool haveAvx() {
+  static const bool avx = __builtin_cpu_supports("avx");
+  return avx;
+}
+#endif
+
+template <bool kTether>
+void project(Vec4* x, const uint32_t* A, const uint32_t* B, const float* rest, const float* inv_w,
+             size_t m, float scale) {
+#if DRAPE_XPBD_AVX
+  if (haveAvx()) return projectBatchesAvx<kTether>(x, A, B, rest, inv_w, m, scale);
+#endif
+  projectBatches<kTether>(x, A, B, rest, inv_w, m, scale);
+}
 
 }  // namespace
 
 XpbdSolver::XpbdSolver(GarmentTopology topology) : topology_(std::move(topology)) {
   const size_t n = topology_.particleCount();
-  x_.resize(n);
-  prev_.resize(n);
-  v_.assign(n, Vec4::Zero());
+  x_.resize(n + 1);
+  v_.assign(n + 1, Vec4::Zero());
   for (size_t i = 0; i < n; ++i) {
     const Vec3& p = topology_.rest_positions[i];
     x_[i] = Vec4(p.x(), p.y(), p.z(), topology_.inverse_mass[i]);
   }
+  x_[n] = Vec4::Zero();  // the dummy particle padding constraints point at (w = 0: never moves)
   prev_ = x_;
   pin_start_.resize(topology_.pinned.size());
   pin_target_.resize(topology_.pinned.size());
   for (size_t k = 0; k < topology_.pinned.size(); ++k)
     pin_target_[k] = topology_.rest_positions[topology_.pinned[k]];
+  buildBatches();
+}
+
+void XpbdSolver::buildBatches() {
+  const uint32_t dummy = static_cast<uint32_t>(topology_.particleCount());
+  distance_ = Batches{};
+  tethers_ = Batches{};
+  distance_kind_.clear();
+  const DistanceConstraints* kinds[3] = {&topology_.stretch, &topology_.shear, &topology_.bend};
+  for (uint8_t k = 0; k < 3; ++k) {
+    appendPadded(*kinds[k], 0.0f, dummy, &distance_kind_, k, distance_.a, distance_.b,
+                 distance_.rest, distance_.compliance, distance_.group_offsets);
+  }
+  appendPadded(topology_.tether, 0.0f, dummy, nullptr, 0, tethers_.a, tethers_.b,
+               tethers_.rest, tethers_.compliance, tethers_.group_offsets);
+  refreshCompliance();
+}
+
+void XpbdSolver::refreshCompliance() {
+  inv_w_h2_ = -1.0f;  // recompute inv_w at the next substep
+  distance_.inv_w.resize(distance_.a.size());
+  tethers_.inv_w.resize(tethers_.a.size());
+  const float by_kind[4] = {params_.stretch_compliance, params_.shear_compliance,
+                            params_.bend_compliance, 0.0f};
+  for (size_t k = 0; k < distance_kind_.size(); ++k)
+    distance_.compliance[k] = by_kind[distance_kind_[k]];
+  for (size_t k = 0; k < tethers_.a.size(); ++k)
+    tethers_.compliance[k] = tethers_.a[k] == topology_.particleCount() ? 0.0f : params_.tether_compliance;
 }
 
 bool XpbdSolver::setParams(const XpbdParams& p, std::string& error) {
@@ -51,6 +285,7 @@ bool XpbdSolver::setParams(const XpbdParams& p, std::string& error) {
     return false;
   }
   params_ = p;
+  refreshCompliance();
   return true;
 }
 
@@ -71,8 +306,8 @@ bool XpbdSolver::setPinTargets(const Vec3* targets, size_t count, std::string& e
 }
 
 bool XpbdSolver::reset(const Vec3* positions, size_t count, std::string& error) {
-  if (count != x_.size() || positions == nullptr) {
-    error = "expected " + std::to_string(x_.size()) + " positions, got " + std::to_string(count);
+  if (count != particleCount() || positions == nullptr) {
+    error = "expected " + std::to_string(particleCount()) + " positions, got " + std::to_string(count);
     return false;
   }
   for (size_t i = 0; i < count; ++i) {
@@ -95,10 +330,13 @@ bool XpbdSolver::step(float dt, int substeps) {
   for (size_t k = 0; k < pin_start_.size(); ++k)
     pin_start_[k] = x_[topology_.pinned[k]].head<3>();
   collision_stats_ = CollisionStats{};
+  timings_ = XpbdTimings{};
   const float h = dt / static_cast<float>(substeps);
   const float inv_n = 1.0f / static_cast<float>(substeps);
   for (int s = 0; s < substeps; ++s) {
+    const Clock::time_point t0 = timing_ ? Clock::now() : Clock::time_point{};
     const EllipsoidCollider* collider = motion_.active() ? motion_.beginSubstep(s, substeps) : collider_;
+    if (timing_) timings_.collision_ns += nsBetween(t0, Clock::now());
     substep(h, s + 1 == substeps ? 1.0f : static_cast<float>(s + 1) * inv_n, collider);
   }
   return true;
@@ -106,7 +344,7 @@ bool XpbdSolver::step(float dt, int substeps) {
 
 void XpbdSolver::transform(const Mat3& R, const Vec3& pivot, const Vec3& t, float velocity_scale) {
   const Vec3 shift = pivot + t;
-  for (size_t i = 0; i < x_.size(); ++i) {
+  for (size_t i = 0; i < particleCount(); ++i) {
     x_[i].head<3>() = R * (Vec3(x_[i].head<3>()) - pivot) + shift;
     prev_[i].head<3>() = R * (Vec3(prev_[i].head<3>()) - pivot) + shift;
     v_[i].head<3>() = velocity_scale * (R * Vec3(v_[i].head<3>()));
@@ -115,86 +353,70 @@ void XpbdSolver::transform(const Mat3& R, const Vec3& pivot, const Vec3& t, floa
 }
 
 void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider) {
+  const Clock::time_point start = timing_ ? Clock::now() : Clock::time_point{};
+  const double collision_before = timings_.collision_ns;
   const XpbdParams& p = params_;
-  const size_t n = x_.size();
-  const Vec3 g = p.gravity;
+  const size_t n = particleCount();
+  Vec4* x = x_.data();
+  Vec4* prev = prev_.data();
+  Vec4* vel = v_.data();
+  // 1. Predict: explicit velocity update (gravity, drag towards the wind), clamp, move. Four-lane
+  // arithmetic with w = 0 in v, g and the wind, so x's w (inverse mass) is carried unchanged.
+  const Vec4 hg = h * Vec4(p.gravity.x(), p.gravity.y(), p.gravity.z(), 0.0f);
+  const Vec4 wind(p.wind.x(), p.wind.y(), p.wind.z(), 0.0f);
+  const float h_drag = h * p.drag;
   const float max_speed2 = p.max_speed > 0.0f ? p.max_speed * p.max_speed : 0.0f;
-  // 1. Predict: explicit velocity update (gravity, drag towards the wind), clamp, move.
   for (size_t i = 0; i < n; ++i) {
-    prev_[i] = x_[i];
-    if (x_[i].w() == 0.0f) continue;
-    Vec3 v = v_[i].head<3>();
-    v += h * (g + p.drag * (p.wind - v));
+    const Vec4 xi = x[i];
+    prev[i] = xi;
+    if (xi.w() == 0.0f) continue;
+    Vec4 v = vel[i];
+    v += hg + h_drag * (wind - v);
     if (max_speed2 > 0.0f) {
       const float s2 = v.squaredNorm();
       if (s2 > max_speed2) v *= p.max_speed / std::sqrt(s2);
     }
-    v_[i].head<3>() = v;
-    x_[i].head<3>() += h * v;
+    vel[i] = v;
+    x[i] = xi + h * v;
   }
   // Pinned particles follow their targets, interpolated linearly across the step.
   for (size_t k = 0; k < pin_target_.size(); ++k) {
     const Vec3 at = pin_start_[k] + pin_t * (pin_target_[k] - pin_start_[k]);
-    x_[topology_.pinned[k]].head<3>() = at;
+    x[topology_.pinned[k]].head<3>() = at;
   }
-  // 2. One XPBD iteration per constraint kind, colour by colour (alpha~ = alpha / h^2).
+  // 2. One XPBD iteration: stretch, shear, bend colour by colour (one list), then tethers
+  // (alpha~ = alpha / h^2).
   const float inv_h2 = 1.0f / (h * h);
-  project(topology_.stretch, p.stretch_compliance * inv_h2);
-  project(topology_.shear, p.shear_compliance * inv_h2);
-  project(topology_.bend, p.bend_compliance * inv_h2);
-  projectTethers(p.tether_compliance * inv_h2);
+  if (inv_h2 != inv_w_h2_) {  // h changed (or params): refresh 1 / (w_a + w_b + alpha~)
+    inv_w_h2_ = inv_h2;
+    for (Batches* b : {&distance_, &tethers_}) {
+      for (size_t k = 0; k < b->a.size(); ++k) {
+        const float wb = b == &tethers_ ? 0.0f : x[b->b[k]].w();
+        const float wsum = x[b->a[k]].w() + wb + b->compliance[k] * inv_h2;
+        b->inv_w[k] = wsum > 0.0f ? 1.0f / wsum : 0.0f;
+      }
+    }
+  }
+  project<false>(x, distance_.a.data(), distance_.b.data(), distance_.rest.data(),
+                        distance_.inv_w.data(), distance_.a.size(), 1.0f);
+  project<true>(x, tethers_.a.data(), tethers_.b.data(), tethers_.rest.data(),
+                       tethers_.inv_w.data(), tethers_.a.size(), p.tether_scale);
   // 3. Collision against the tracking ellipsoids.
   if (collider != nullptr) {
-    const CollisionStats cs = collider->collide(x_.data(), prev_.data(), n, p.collision);
+    const Clock::time_point t0 = timing_ ? Clock::now() : Clock::time_point{};
+    const CollisionStats cs = collider->collide(x, prev, n, p.collision);
     collision_stats_.tests += cs.tests;
     collision_stats_.contacts += cs.contacts;
     collision_stats_.swept_catches += cs.swept_catches;
     collision_stats_.escapes += cs.escapes;
+    if (timing_) timings_.collision_ns += nsBetween(t0, Clock::now());
   }
-  // 4. Velocities from positions, then damping.
-  const float inv_h = 1.0f / h;
-  const float keep = std::exp(-p.damping * h);
-  for (size_t i = 0; i < n; ++i) {
-    Vec3 v = (x_[i].head<3>() - prev_[i].head<3>()) * inv_h;
-    v_[i].head<3>() = v * keep;
-  }
-}
-
-void XpbdSolver::project(const DistanceConstraints& c, float alpha_tilde) {
-  const size_t m = c.size();
-  Vec4* x = x_.data();
-  for (size_t k = 0; k < m; ++k) {
-    Vec4& pa = x[c.a[k]];
-    Vec4& pb = x[c.b[k]];
-    const float wa = pa.w(), wb = pb.w();
-    const float wsum = wa + wb + alpha_tilde;
-    if (wsum <= 0.0f) continue;
-    const Vec3 d = pa.head<3>() - pb.head<3>();
-    const float len = d.norm();
-    if (len <= 1e-9f) continue;
-    // Delta lambda = -C / (w_a + w_b + alpha~), lambda starting at 0 (one iteration).
-    const float dl = -(len - c.rest[k]) / wsum;
-    const Vec3 corr = (dl / len) * d;
-    pa.head<3>() += wa * corr;
-    pb.head<3>() -= wb * corr;
-  }
-}
-
-void XpbdSolver::projectTethers(float alpha_tilde) {
-  const DistanceConstraints& c = topology_.tether;
-  const float scale = params_.tether_scale;
-  Vec4* x = x_.data();
-  for (size_t k = 0; k < c.size(); ++k) {
-    Vec4& pa = x[c.a[k]];
-    const Vec3 d = pa.head<3>() - x[c.b[k]].head<3>();
-    const float len2 = d.squaredNorm();
-    const float limit = c.rest[k] * scale;
-    if (len2 <= limit * limit) continue;  // inequality: only pulls back
-    const float len = std::sqrt(len2);
-    const float wa = pa.w();
-    if (wa + alpha_tilde <= 0.0f) continue;
-    const float dl = -(len - limit) / (wa + alpha_tilde);
-    pa.head<3>() += (wa * dl / len) * d;
+  // 4. Velocities from positions, then damping (w lane: w - w = 0).
+  const float scale = std::exp(-p.damping * h) / h;
+  for (size_t i = 0; i < n; ++i) vel[i] = (x[i] - prev[i]) * scale;
+  if (timing_) {
+    const double collided = timings_.collision_ns - collision_before;
+    timings_.constraints_ns += nsBetween(start, Clock::now()) - collided;
   }
 }
 

@@ -15,6 +15,7 @@
 #include "proxies/collision.h"
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,13 @@ struct XpbdParams {
   Vec3 wind = Vec3::Zero();       // m/s
   float max_speed = 20.0f;        // m/s, speed clamp after integration; <= 0: none
   CollisionParams collision;      // used when a collider is set
+};
+
+// Wall-clock split of the last step (only measured when enabled, for benchmarks): constraints =
+// prediction, projection and velocity update; collision = per-substep collider setup + collide().
+struct XpbdTimings {
+  double constraints_ns = 0.0;
+  double collision_ns = 0.0;
 };
 
 class XpbdSolver {
@@ -77,25 +85,46 @@ class XpbdSolver {
   bool step(float dt, int substeps = kDefaultSubsteps);
 
   const GarmentTopology& topology() const { return topology_; }
-  size_t particleCount() const { return x_.size(); }
+  size_t particleCount() const { return topology_.particleCount(); }
   const Eigen::Vector4f* positions() const { return x_.data(); }    // w = inverse mass
+  // Writable xyz for callers that constrain particles between steps (keep w as it is).
+  Eigen::Vector4f* mutablePositions() { return x_.data(); }
   const Eigen::Vector4f* velocities() const { return v_.data(); }   // w = 0
   // Collision statistics summed over the last step's substeps.
   const CollisionStats& lastCollisionStats() const { return collision_stats_; }
+  // Off by default (two clock reads per substep part when on).
+  void setTimingEnabled(bool on) { timing_ = on; }
+  const XpbdTimings& lastTimings() const { return timings_; }
 
  private:
   // pin_t: fraction of the step at the substep end; collider: this substep's, or null.
   void substep(float h, float pin_t, const EllipsoidCollider* collider);
-  void project(const DistanceConstraints& c, float alpha_tilde);
-  void projectTethers(float alpha_tilde);
+  // Constraint storage for the SIMD kernels: every colour group padded to a multiple of kLanes
+  // with dummy constraints on the dummy particle x_[n] (w = 0, never read back), so a batch of
+  // kLanes constraints shares no particle and needs no tail loop. Stretch, shear and bend are
+  // one list (their colour groups concatenated in that order: the same Gauss–Seidel order as
+  // three passes), each constraint carrying its kind's compliance.
+  struct Batches {
+    std::vector<uint32_t> a, b;
+    std::vector<float> rest, compliance;
+    std::vector<float> inv_w;  // 1 / (w_a + w_b + compliance / h^2), for inv_w_h2_; 0 = inert
+    std::vector<uint32_t> group_offsets{0};
+  };
+  void buildBatches();
+  void refreshCompliance();  // after setParams
 
   GarmentTopology topology_;
   XpbdParams params_;
-  std::vector<Eigen::Vector4f> x_, prev_, v_;
+  Batches distance_, tethers_;
+  float inv_w_h2_ = -1.0f;  // the 1/h^2 that Batches::inv_w was computed for
+  std::vector<uint8_t> distance_kind_;  // 0 stretch, 1 shear, 2 bend (3 padding), per entry
+  std::vector<Eigen::Vector4f> x_, prev_, v_;  // n + 1 entries: x_[n] is the dummy particle
   std::vector<Vec3> pin_start_, pin_target_;
   const EllipsoidCollider* collider_ = nullptr;
   ColliderMotion motion_;
   CollisionStats collision_stats_;
+  bool timing_ = false;
+  XpbdTimings timings_;
 };
 
 }  // namespace drape

@@ -9,6 +9,9 @@
 #if defined(_MSC_VER)
 #include <intrin.h>
 #endif
+#if defined(__SSE2__) || defined(_M_X64)
+#include <emmintrin.h>
+#endif
 
 namespace drape {
 namespace {
@@ -72,6 +75,78 @@ inline void applyFriction(const Mat3& to_unit_end, const Vec3& c_end, const Mat3
   x -= f * tangential;
 }
 
+using Vec4 = Eigen::Vector4f;
+// xyz0 built in registers: going through a 12-byte store and a 16-byte load stalls on store
+// forwarding (it cost more than the narrow test itself).
+#if defined(__SSE2__) || defined(_M_X64)
+inline Vec4 lift(const Vec3& v) {
+  const __m128 xy = _mm_unpacklo_ps(_mm_set_ss(v.x()), _mm_set_ss(v.y()));
+  Vec4 out;
+  _mm_store_ps(out.data(), _mm_movelh_ps(xy, _mm_set_ss(v.z())));
+  return out;
+}
+#else
+inline Vec4 lift(const Vec3& v) { return Vec4(v.x(), v.y(), v.z(), 0.0f); }
+#endif
+// q = U d for U given by its columns (w lanes 0).
+inline Vec4 mulq(const Vec4* u, const Vec4& d) {
+  return u[0] * d.x() + u[1] * d.y() + u[2] * d.z();
+}
+// Box tests on 4 lanes (w lanes are 0 on both sides, so they always pass), one branch.
+#if defined(__SSE2__) || defined(_M_X64)
+inline bool overlaps4(const Vec4& lo, const Vec4& hi, const Vec4& mn, const Vec4& mx) {
+  const __m128 in = _mm_and_ps(_mm_cmple_ps(_mm_load_ps(lo.data()), _mm_load_ps(mx.data())),
+                               _mm_cmpge_ps(_mm_load_ps(hi.data()), _mm_load_ps(mn.data())));
+  return _mm_movemask_ps(in) == 0xF;
+}
+inline bool contains4(const Vec4& mn, const Vec4& mx, const Vec4& p) {
+  return overlaps4(p, p, mn, mx);
+}
+#else
+inline bool overlaps4(const Vec4& lo, const Vec4& hi, const Vec4& mn, const Vec4& mx) {
+  return ((lo.array() <= mx.array()).cast<int>() * (hi.array() >= mn.array()).cast<int>()).sum() == 4;
+}
+inline bool contains4(const Vec4& mn, const Vec4& mx, const Vec4& p) {
+  return overlaps4(p, p, mn, mx);
+}
+#endif
+
+// Closest point on an ellipsoid (radii^2 b, local frame) to the local point y = e * q inside it
+// near its surface (|q|^2 = r2 >= 0.64), in float: x_i = b_i y_i / (b_i + t) with t the root of
+// F(t) = sum (e_i y_i / (b_i + t))^2 - 1 in (-b_min, 0] (F convex and decreasing there), by
+// Newton steps kept inside the bracket (bisection otherwise). The first step is at t = 0, where
+// F = r2 - 1 and F' = -2 sum q_i^2 / b_i need no division. A resting contact (|q| ~ 0.999)
+// converges in one or two steps. False when it does not converge in 8 steps (near the medial
+// surface of a flat ellipsoid, or deeper points): the caller then uses the double solver.
+inline bool closestInsideFloat(const Vec4& b, const Vec4& q, float r2, Vec3& local, Vec3& qc) {
+  if (!(r2 >= 0.64f)) return false;
+  const Vec4 e = b.cwiseSqrt();
+  const Vec4 y = e.cwiseProduct(q);  // local point
+  const Vec4 a = y.cwiseProduct(e);  // e_i y_i
+  float lo = -b.head<3>().minCoeff(), hi = 0.0f, t = 0.0f;
+  float F = r2 - 1.0f;
+  float dF = -2.0f * (q.array().square() / (b.array() + Eigen::Array4f(0, 0, 0, 1))).sum();
+  Eigen::Array4f r = Eigen::Array4f::Zero();
+  for (int it = 0; it < 8; ++it) {
+    if (F < 0.0f) hi = t; else lo = t;
+    float tn = dF < 0.0f ? t - F / dF : lo;
+    if (!(tn > lo && tn < hi)) tn = 0.5f * (lo + hi);
+    t = tn;
+    r = (b.array() + t + Eigen::Array4f(0, 0, 0, 1)).inverse();
+    const Eigen::Array4f u = a.array() * r;
+    F = (u * u).sum() - 1.0f;
+    if (std::fabs(F) < 2e-6f) {
+      const Eigen::Array4f x = b.array() * y.array() * r;
+      local = Vec3(x[0], x[1], x[2]);
+      const Eigen::Array4f qq = y.array() * r * e.array();  // x / e
+      qc = Vec3(qq[0], qq[1], qq[2]);
+      return true;
+    }
+    dF = -2.0f * (u * u * r).sum();
+  }
+  return false;
+}
+
 // A swept contact is answered at the entry point when the discrete response would land more
 // than 45 degrees (round the unit sphere) away from it.
 constexpr float kDeepContactCos = 0.70710678f;
@@ -125,6 +200,7 @@ void EllipsoidCollider::setEllipsoids(const Ellipsoid* start, const Ellipsoid* e
   }
   margin_ = (margin_m >= 0.0f && std::isfinite(margin_m)) ? margin_m : 0.0f;
   shapes_.resize(static_cast<size_t>(count));
+  quick_.resize(static_cast<size_t>(count));
   constexpr float kInf = std::numeric_limits<float>::infinity();
   grid_min_ = Vec3::Constant(kInf);
   grid_max_ = Vec3::Constant(-kInf);
@@ -150,6 +226,7 @@ void EllipsoidCollider::setEllipsoids(const Ellipsoid* start, const Ellipsoid* e
     if (!ok) {  // never matches: empty boxes
       s.end_min = s.swept_min = Vec3::Constant(kInf);
       s.end_max = s.swept_max = Vec3::Constant(-kInf);
+      refreshQuick(k);
       continue;
     }
     s.swept_min = s.end_min.cwiseMin(start_min);
@@ -169,6 +246,7 @@ void EllipsoidCollider::setEllipsoids(const Ellipsoid* start, const Ellipsoid* e
     s.inside_tol2 = (1.0f - tol) * (1.0f - tol);
     const float graze = std::min(0.5f * margin_ / r_max, 1.0f);
     s.graze = (1.0f - graze) * (1.0f - graze);
+    refreshQuick(k);
   }
   if (!any || count > kMaxGridEllipsoids) return;
 
@@ -214,10 +292,30 @@ void EllipsoidCollider::setEllipsoids(const Ellipsoid* start, const Ellipsoid* e
   grid_ = true;
 }
 
+void EllipsoidCollider::refreshQuick(int k) {
+  const Shape& s = shapes_[static_cast<size_t>(k)];
+  Quick& q = quick_[static_cast<size_t>(k)];
+  q.end_c = lift(s.end.centre);
+  q.start_c = lift(s.start.centre);
+  for (int i = 0; i < 3; ++i) {
+    q.end_u[i] = lift(s.end.to_unit.col(i));
+    q.start_u[i] = lift(s.start.to_unit.col(i));
+  }
+  q.swept_min = lift(s.swept_min);
+  q.swept_max = lift(s.swept_max);
+  q.end_min = lift(s.end_min);
+  q.end_max = lift(s.end_max);
+  q.radii2 = lift(s.radii.cwiseProduct(s.radii));
+  q.inside_tol2 = s.inside_tol2;
+  q.graze = s.graze;
+}
+
 #if defined(__GNUC__)
 #define DRAPE_ALWAYS_INLINE __attribute__((always_inline)) inline
+#define DRAPE_LAMBDA_INLINE __attribute__((always_inline))
 #else
 #define DRAPE_ALWAYS_INLINE inline
+#define DRAPE_LAMBDA_INLINE
 #endif
 
 DRAPE_ALWAYS_INLINE bool EllipsoidCollider::gather(const Vec3& lo, const Vec3& hi, bool use_grid,
@@ -227,8 +325,10 @@ DRAPE_ALWAYS_INLINE bool EllipsoidCollider::gather(const Vec3& lo, const Vec3& h
   if (c.all) return true;
   c.lo = cellsOf(lo, cell_origin_, cell_scale_, cell_top_);
   c.hi = cellsOf(hi, cell_origin_, cell_scale_, cell_top_);
-  if (words_ == 1 && (c.lo == c.hi).all()) {
-    c.mask[0] = cells_[static_cast<size_t>((c.lo[2] * dims_[1] + c.lo[1]) * dims_[0] + c.lo[0])];
+  if ((c.lo == c.hi).all()) {  // the usual case: one cell
+    const uint64_t* cell =
+        &cells_[static_cast<size_t>(((c.lo[2] * dims_[1] + c.lo[1]) * dims_[0] + c.lo[0]) * words_)];
+    for (int w = 0; w < words_; ++w) c.mask[w] = cell[w];
     return true;
   }
   for (int w = 0; w < words_; ++w) c.mask[w] = 0;
@@ -276,10 +376,11 @@ int EllipsoidCollider::firstContaining(const Vec3& x, bool use_grid, CollisionSt
   int found = -1;
   forCandidates(x, x, use_grid, [&](int k) {
     if (found >= 0) return;
-    const Shape& s = shapes_[static_cast<size_t>(k)];
-    if (!containsPoint(s.end_min, s.end_max, x)) return;
+    const Quick& qk = quick_[static_cast<size_t>(k)];
+    const Vec4 x4 = lift(x);
+    if (!contains4(qk.end_min, qk.end_max, x4)) return;
     ++st.tests;
-    if (mulv(s.end.to_unit, x - s.end.centre).squaredNorm() < s.inside_tol2) found = k;
+    if (mulq(qk.end_u, x4 - qk.end_c).squaredNorm() < qk.inside_tol2) found = k;
   });
   return found;
 }
@@ -291,9 +392,13 @@ Vec3 EllipsoidCollider::respond(const Shape& s, const Vec3& x, const Vec3& q, fl
     q_contact = r2 > 1e-30f ? Vec3(q / std::sqrt(r2)) : Vec3(Vec3::Unit(s.smallest_axis));
     return s.end.centre + mulv(s.end.from_unit, q_contact);
   }
-  const Vec3 local = mulvT(s.rotation, x - s.end.centre);
-  const Vec3 y = closestPointOnEllipsoidFast(s.radii, local);
-  q_contact = y.cwiseQuotient(s.radii);
+  Vec3 y;
+  const Quick& qk = quick_[static_cast<size_t>(&s - shapes_.data())];
+  if (!closestInsideFloat(qk.radii2, lift(q), r2, y, q_contact)) {
+    const Vec3 local = mulvT(s.rotation, x - s.end.centre);
+    y = closestPointOnEllipsoidFast(s.radii, local);
+    q_contact = y.cwiseQuotient(s.radii);
+  }
   return s.end.centre + mulv(s.rotation, y);
 }
 
@@ -382,6 +487,51 @@ void EllipsoidCollider::escape(Vec3& x, ContactResponse mode, bool use_grid,
   x = best_x;
 }
 
+// The response to one contact of pass 0 (discrete or swept), friction included. Kept out of
+// line so the candidate loop around the narrow test stays small and inlined.
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+void EllipsoidCollider::contact(const Shape& s, const Eigen::Vector4f& q1_4, float r2,
+                                const Eigen::Vector4f& q0_4, float q0sq, bool inside, bool cont,
+                                bool friction, const Vec3& x0, const CollisionParams& p, Vec3& x,
+                                CollisionStats& st) const {
+  const Vec3 q1 = q1_4.head<3>(), q0 = q0_4.head<3>();
+  Vec3 target, qc;
+  bool swept = false;
+  if (inside) {
+    target = respond(s, x, q1, r2, p.response, qc);
+    // Entered during this substep: if the discrete push would move it far round the surface
+    // from where it came in (it went deep, e.g. a fast limb), use the entry point.
+    // The cone of directions within 45 degrees of qc is convex: when q0 and q1 both lie in
+    // it, so does the whole segment and its entry point, and the test below cannot fire.
+    if (cont && q0sq >= s.inside_tol2) {
+      const float d0 = qc.dot(q0), d1 = qc.dot(q1);
+      constexpr float kCos2 = kDeepContactCos * kDeepContactCos;
+      const bool in_cone = (d0 >= 0.0f) & (d1 >= 0.0f) & (d0 * d0 >= kCos2 * q0sq) &
+                           (d1 * d1 >= kCos2 * r2);
+      if (!in_cone) {
+        const Vec3 qe = entryPoint(q0, q0sq, q1);
+        if (qc.dot(qe) < kDeepContactCos) {
+          target = slideFromEntry(s, qe, q1, qc);
+          swept = true;
+        }
+      }
+    }
+  } else {
+    target = slideFromEntry(s, entryPoint(q0, q0sq, q1), q1, qc);
+    swept = true;
+  }
+  ++st.contacts;
+  if (swept) ++st.swept_catches;
+  const Vec3 before = x;
+  x = target;
+  if (friction) {
+    applyFriction(s.end.to_unit, s.end.centre, s.end.from_unit, s.start.centre,
+                  s.start.from_unit, qc, before, x0, p.static_friction, p.kinetic_friction, x);
+  }
+}
+
 void EllipsoidCollider::resolveParticle(Vec3& x, const Vec3& x0, bool has_prev,
                                         const CollisionParams& p, CollisionStats& st) const {
   const bool cont = p.continuous && has_prev;
@@ -398,57 +548,33 @@ void EllipsoidCollider::resolveParticle(Vec3& x, const Vec3& x0, bool has_prev,
   bool moved = false;
   Candidates first;
   if (!gather(lo, hi, use_grid, first)) return;
-  iterate(first, [&](int k) {
-    const Shape& s = shapes_[static_cast<size_t>(k)];
-    const bool in_box = cont ? overlaps(lo, hi, s.swept_min, s.swept_max)
-                             : containsPoint(s.end_min, s.end_max, x_end);
+  const Vec4 lo4 = lift(lo), hi4 = lift(hi), x0_4 = lift(x0), x_end4 = lift(x_end);
+  iterate(first, [&](int k) DRAPE_LAMBDA_INLINE {
+    const Quick& qk = quick_[static_cast<size_t>(k)];
+    const bool in_box = cont ? overlaps4(lo4, hi4, qk.swept_min, qk.swept_max)
+                             : contains4(qk.end_min, qk.end_max, x_end4);
     if (!in_box) return;
     ++st.tests;
     // Past the box test, no contact is decided with one branch: the discrete and the swept
-    // tests are both evaluated and combined.
-    const Vec3 q1 = mulv(s.end.to_unit, x - s.end.centre);
-    const float r2 = q1.squaredNorm();
+    // tests are both evaluated and combined (4-lane arithmetic on the Quick copy).
+    const Vec4 q1_4 = mulq(qk.end_u, lift(x) - qk.end_c);
+    const float r2 = q1_4.squaredNorm();
     const bool inside = r2 < 1.0f;
-    Vec3 q0 = Vec3::Zero();
+    Vec4 q0_4 = Vec4::Zero();
     float q0sq = 0.0f;
     bool crossed = false;
     if (cont) {
       // Outside at both ends: did the relative path q0 -> q1 pass through the unit ball (deeper
       // than the graze threshold)? Closest approach^2 = q0sq - b^2 / a, compared times a.
-      q0 = mulv(s.start.to_unit, x0 - s.start.centre);
-      q0sq = q0.squaredNorm();
-      const Vec3 d = q1 - q0;
-      const float a = d.squaredNorm(), b = q0.dot(d);
+      q0_4 = mulq(qk.start_u, x0_4 - qk.start_c);
+      q0sq = q0_4.squaredNorm();
+      const Vec4 d = q1_4 - q0_4;
+      const float a = d.squaredNorm(), b = q0_4.dot(d);
       crossed = !inside & (q0sq >= 1.0f) & (b < 0.0f) & (a > 0.0f) & (-b <= a) &
-                (q0sq * a - b * b < s.graze * a);
+                (q0sq * a - b * b < qk.graze * a);
     }
     if (!(inside | crossed)) return;
-    Vec3 target, qc;
-    bool hit = true, swept = false;
-    if (inside) {
-      target = respond(s, x, q1, r2, p.response, qc);
-      // Entered during this substep: if the discrete push would move it far round the surface
-      // from where it came in (it went deep, e.g. a fast limb), use the entry point.
-      if (cont && q0sq >= s.inside_tol2) {
-        const Vec3 qe = entryPoint(q0, q0sq, q1);
-        if (qc.dot(qe) < kDeepContactCos) {
-          target = slideFromEntry(s, qe, q1, qc);
-          swept = true;
-        }
-      }
-    } else {
-      target = slideFromEntry(s, entryPoint(q0, q0sq, q1), q1, qc);
-      swept = true;
-    }
-    if (!hit) return;
-    ++st.contacts;
-    if (swept) ++st.swept_catches;
-    const Vec3 before = x;
-    x = target;
-    if (friction) {
-      applyFriction(s.end.to_unit, s.end.centre, s.end.from_unit, s.start.centre,
-                    s.start.from_unit, qc, before, x0, p.static_friction, p.kinetic_friction, x);
-    }
+    contact(shapes_[static_cast<size_t>(k)], q1_4, r2, q0_4, q0sq, inside, cont, friction, x0, p, x, st);
     moved = true;
   });
 
@@ -463,15 +589,16 @@ void EllipsoidCollider::resolveParticle(Vec3& x, const Vec3& x0, bool has_prev,
       if (!gather(xp, xp, use_grid, again)) break;
       c = &again;
     }
+    const Vec4 xp4 = lift(xp);
     iterate(*c, [&](int k) {
-      const Shape& s = shapes_[static_cast<size_t>(k)];
-      if (!containsPoint(s.end_min, s.end_max, xp)) return;
+      const Quick& qk = quick_[static_cast<size_t>(k)];
+      if (!contains4(qk.end_min, qk.end_max, xp4)) return;
       ++st.tests;
-      const Vec3 q = mulv(s.end.to_unit, x - s.end.centre);
-      const float r2 = q.squaredNorm();
-      if (!(r2 < s.inside_tol2)) return;
+      const Vec4 q4 = mulq(qk.end_u, lift(x) - qk.end_c);
+      const float r2 = q4.squaredNorm();
+      if (!(r2 < qk.inside_tol2)) return;
       Vec3 qc;
-      x = respond(s, x, q, r2, p.response, qc);
+      x = respond(shapes_[static_cast<size_t>(k)], x, q4.head<3>(), r2, p.response, qc);
       moved = true;
     });
   }

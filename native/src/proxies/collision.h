@@ -88,6 +88,15 @@ class EllipsoidCollider {
     float graze = 0.0f;                // swept chords shallower than this (unit space) ignored
     int smallest_axis = 0;
   };
+  // Hot-path copy of a shape in 16-byte lanes (w = 0): what every narrow test reads, so a test
+  // is a few 4-wide multiply-adds. Shape keeps the rest for the (rarer) responses.
+  struct Quick {
+    Eigen::Vector4f end_c, end_u[3];      // end centre, columns of end to_unit
+    Eigen::Vector4f start_c, start_u[3];  // start centre, columns of start to_unit
+    Eigen::Vector4f swept_min, swept_max, end_min, end_max;
+    Eigen::Vector4f radii2;               // inflated end radii squared (exact response)
+    float inside_tol2 = 1.0f, graze = 0.0f;
+  };
   using Mask = uint64_t[kMaxGridEllipsoids / 64];
 
   // Candidate ellipsoids for a box: the union of the masks of the cells it touches (grid) or all.
@@ -111,10 +120,15 @@ class EllipsoidCollider {
                        CollisionStats& stats) const;
   Vec3 respond(const Shape& s, const Vec3& x, const Vec3& q, float r2, ContactResponse mode,
                Vec3& q_contact) const;
+  void refreshQuick(int k);
+  void contact(const Shape& s, const Eigen::Vector4f& q1, float r2, const Eigen::Vector4f& q0,
+               float q0sq, bool inside, bool cont, bool friction, const Vec3& x0,
+               const CollisionParams& p, Vec3& x, CollisionStats& st) const;
   Vec3 slideFromEntry(const Shape& s, const Vec3& qe, const Vec3& q1, Vec3& q_contact) const;
   void escape(Vec3& x, ContactResponse mode, bool use_grid, CollisionStats& stats) const;
 
   std::vector<Shape> shapes_;
+  std::vector<Quick> quick_;
   std::vector<uint64_t> cells_;  // dims_ cells (x fastest) x words_ bitmask words
   int dims_[3] = {1, 1, 1};
   int words_ = 0;
