@@ -1,7 +1,13 @@
-# Runs drape-replay and checks its stats JSON (ctest: replay_default, replay_bvh).
+# Runs drape-replay and checks its stats JSON (ctest: replay_default, replay_no_garment,
+# replay_garment_obj, replay_bvh).
 #   cmake -DEXE=... -DOUT_DIR=... -DARGS="a|b|c" -DEXPECT_FRAMES=N -DEXPECT_OBJ=N
+#         [-DEXPECT_GARMENT=template|obj|none -DEXPECT_GARMENT_OBJ=N -DEXPECT_MEASURED=N]
 #         [-DEXPECT_FORMAT=kinect_csv] [-DVOLUME_MIN_L=x -DVOLUME_MAX_L=y] [-DPYTHON=python3]
 #         -P check_stats.cmake
+# EXPECT_GARMENT (default template) is garment.source. With a garment it requires particles > 0,
+# every garment number finite (a JSON number, not null) and one step per updated frame; with
+# none, particles = 0 and the cloth keys null. No physics quality bounds (stretch, penetration):
+# those belong to the cloth tests and benchmarks.
 # The program is run with --out OUT_DIR (emptied first) plus ARGS; stats are read from
 # OUT_DIR/stats.json with string(JSON), so no Python is needed (PYTHON, when given, also runs
 # `python3 -m json.tool` on the file).
@@ -61,7 +67,13 @@ foreach(path "drape_version" "recording" "format" "layout" "frames" "rejected_fr
              "shape|neck_mm" "shape|chest_mm" "shape|waist_mm" "shape|hip_mm" "shape|thigh_mm"
              "shape|calf_mm" "shape|upper_arm_mm" "shape|forearm_mm" "ring_points"
              "stages_ms|proxies" "proxies|count" "proxies|rule" "proxies|frames_measured"
-             "proxies|fit_p95_mm" "proxies|fit_max_mm" "proxies|outside_fraction")
+             "proxies|fit_p95_mm" "proxies|fit_max_mm" "proxies|outside_fraction"
+             "stages_ms|cloth" "stages_ms|integrate" "stages_ms|collide" "stages_ms|frame" "particles"
+             "garment|kind" "garment|source" "garment|solver" "garment|substep_hz" "garment|triangles"
+             "garment|edges" "garment|attached" "garment|frames_stepped" "garment|max_stretch"
+             "garment|p99_stretch" "garment|proxy_inside" "garment|body_penetration_mm|p99"
+             "garment|body_penetration_mm|max" "garment|deeper_than_2mm" "garment|frames_measured"
+             "garment|teleport_resets" "garment|nan_resets" "garment|contacts" "garment|substeps")
   string(REPLACE "|" ";" _keys "${path}")
   json_get(_unused ${_keys})
 endforeach()
@@ -118,7 +130,95 @@ if(_obj_count GREATER 0)
   expect_equal("f lines in ${_first}" "${_nf}" "${_triangles}")
 endif()
 
+# The garment.
+if(NOT DEFINED EXPECT_GARMENT)
+  set(EXPECT_GARMENT template)
+endif()
+macro(expect_type type)
+  string(JSON _t ERROR_VARIABLE _json_err TYPE "${_json}" ${ARGN})
+  if(NOT _json_err AND NOT _t STREQUAL "${type}")
+    string(REPLACE ";" "." _k "${ARGN}")
+    string(APPEND _failures "  ${_k} is ${_t}, expected ${type}\n")
+  endif()
+endmacro()
+json_get(_particles particles)
+json_get(_source garment source)
+json_get(_stepped garment frames_stepped)
+json_get(_gtriangles garment triangles)
+if(NOT _source STREQUAL EXPECT_GARMENT)
+  string(APPEND _failures "  garment.source = ${_source}, expected ${EXPECT_GARMENT}\n")
+endif()
+set(_garment_numbers "stages_ms|cloth" "stages_ms|integrate" "stages_ms|collide" "garment|substep_hz"
+    "garment|max_stretch" "garment|p99_stretch" "garment|contacts" "garment|substeps")
+set(_garment_measured "garment|body_penetration_mm|p99" "garment|body_penetration_mm|max"
+    "garment|deeper_than_2mm")
+expect_type(NUMBER stages_ms frame)
+if(EXPECT_GARMENT STREQUAL "none")
+  expect_equal("particles" "${_particles}" 0)
+  expect_equal("garment.frames_stepped" "${_stepped}" 0)
+  json_get(_kind garment kind)
+  if(NOT _kind STREQUAL "none")
+    string(APPEND _failures "  garment.kind = ${_kind}, expected none\n")
+  endif()
+  expect_type(NULL garment solver)
+  foreach(path IN LISTS _garment_numbers _garment_measured)
+    string(REPLACE "|" ";" _keys "${path}")
+    expect_type(NULL ${_keys})
+  endforeach()
+else()
+  if(NOT _particles GREATER 0)
+    string(APPEND _failures "  particles = ${_particles}, expected > 0\n")
+  endif()
+  if(NOT _gtriangles GREATER 0)
+    string(APPEND _failures "  garment.triangles = ${_gtriangles}, expected > 0\n")
+  endif()
+  math(EXPR _updated "${_frames} - ${_rejected}")
+  expect_equal("garment.frames_stepped" "${_stepped}" "${_updated}")
+  foreach(path IN LISTS _garment_numbers)
+    string(REPLACE "|" ";" _keys "${path}")
+    expect_type(NUMBER ${_keys})
+  endforeach()
+  json_get(_gmeasured garment frames_measured)
+  if(DEFINED EXPECT_MEASURED)
+    expect_equal("garment.frames_measured" "${_gmeasured}" "${EXPECT_MEASURED}")
+  endif()
+  if(_gmeasured GREATER 0)
+    foreach(path IN LISTS _garment_measured)
+      string(REPLACE "|" ";" _keys "${path}")
+      expect_type(NUMBER ${_keys})
+    endforeach()
+  endif()
+  foreach(path "garment|edges" "garment|attached" "garment|proxy_inside" "garment|frames_measured"
+               "garment|teleport_resets" "garment|nan_resets" "garment|triangles")
+    string(REPLACE "|" ";" _keys "${path}")
+    expect_type(NUMBER ${_keys})
+  endforeach()
+  json_get(_edges garment edges)
+  if(NOT _edges GREATER 0)
+    string(APPEND _failures "  garment.edges = ${_edges}, expected > 0\n")
+  endif()
+endif()
+
+if(DEFINED EXPECT_GARMENT_OBJ)
+  file(GLOB _gobjs "${OUT_DIR}/garment_*.obj")
+  list(LENGTH _gobjs _gobj_count)
+  expect_equal("garment OBJ files" "${_gobj_count}" "${EXPECT_GARMENT_OBJ}")
+  if(_gobj_count GREATER 0)
+    list(SORT _gobjs)
+    list(GET _gobjs 0 _first)
+    file(STRINGS "${_first}" _v REGEX "^v ")
+    file(STRINGS "${_first}" _vn REGEX "^vn ")
+    file(STRINGS "${_first}" _f REGEX "^f [0-9]+//[0-9]+ [0-9]+//[0-9]+ [0-9]+//[0-9]+$")
+    list(LENGTH _v _nv)
+    list(LENGTH _vn _nvn)
+    list(LENGTH _f _nf)
+    expect_equal("v lines in ${_first}" "${_nv}" "${_particles}")
+    expect_equal("vn lines in ${_first}" "${_nvn}" "${_particles}")
+    expect_equal("f lines in ${_first}" "${_nf}" "${_gtriangles}")
+  endif()
+endif()
+
 if(_failures)
   message(FATAL_ERROR "drape-replay stats check failed:\n${_failures}")
 endif()
-message(STATUS "drape-replay stats OK: ${_frames} frames, ${_watertight} watertight, ${_volume} L, ${_obj_count} OBJ files")
+message(STATUS "drape-replay stats OK: ${_frames} frames, ${_watertight} watertight, ${_volume} L, ${_obj_count} body OBJ files, garment ${_source} with ${_particles} particles")

@@ -1,6 +1,7 @@
 // drape-replay: replays a skeleton recording through Drape's public C ABI (drape.h only, linked
-// against the shared library like any user program), checks every body mesh (finite numbers,
-// watertight, enclosed volume), optionally writes one OBJ per frame and writes a stats JSON.
+// against the shared library like any user program), dresses the person in a garment, checks every
+// body mesh (finite numbers, watertight, enclosed volume) and the garment (finite numbers, stretch,
+// penetration), optionally writes body and garment OBJs per frame and writes a stats JSON.
 // Usage and the stats schema: docs/replay.md.
 #include <drape/drape.h>
 
@@ -35,6 +36,8 @@ namespace {
 constexpr int kExitOk = 0;
 constexpr int kExitFailure = 1;
 constexpr int kExitUsage = 2;
+// The paper's mass-spring with explicit Euler needs ~3 kHz (drape.h): 96 substeps per 1/30 s.
+constexpr float kMassSpringSubstepHz = 2880.0f;
 
 // The one-line error on stderr (newlines in library messages are flattened).
 int fail(int code, std::string message) {
@@ -151,6 +154,47 @@ int run(int argc, char** argv) {
     }
   }
 
+  // The garment, sized to the body set above. Owned by the context (destroyed with it).
+  drape_garment* garment = nullptr;
+  drape_cloth_params cloth;
+  drape_cloth_params_init(&cloth);
+  if (!opt.garment_none) {
+    drape_garment_desc gdesc;
+    drape_garment_desc_init(&gdesc);
+    gdesc.solver = opt.solver;
+    if (opt.substeps != 0) cloth.substep_hz = 30.0f * static_cast<float>(opt.substeps);
+    else if (opt.solver == DRAPE_SOLVER_MASS_SPRING) cloth.substep_hz = kMassSpringSubstepHz;
+    // A frame a little longer than 1/30 s must not hit the per-step cap (which would lengthen
+    // every substep instead of adding some).
+    const uint32_t per_frame = static_cast<uint32_t>(std::ceil(cloth.substep_hz / 30.0f));
+    cloth.max_substeps = std::max(cloth.max_substeps, std::min<uint32_t>(1000, 2 * per_frame));
+    if (!opt.garment_obj.empty()) {
+      drape_mesh_fit fit;
+      drape_mesh_fit_init(&fit);
+      if (drape_result r = drape_context_add_garment_obj_file(ctx.get(), opt.garment_obj.c_str(), &fit, &gdesc, &cloth,
+                                                              &garment)) {
+        if (isFatalLibraryError(r))
+          return fail(kExitFailure, "drape_context_add_garment_obj_file failed: " + libraryReason(r));
+        if (r == DRAPE_ERROR_IO)
+          return fail(kExitUsage, "cannot read the garment OBJ (" + libraryReason(r) + "); check the --garment path");
+        return fail(kExitUsage, "the garment OBJ was refused (" + libraryReason(r) +
+                                    "); pass a Wavefront OBJ garment made for a MakeHuman-like body (docs/garment-obj.md)");
+      }
+    } else {
+      drape_garment_template tmpl;
+      drape_garment_template_init(&tmpl);
+      tmpl.kind = opt.garment_kind;
+      if (opt.particles != 0) tmpl.particles = opt.particles;
+      if (drape_result r = drape_context_add_garment_template(ctx.get(), &gdesc, &tmpl, &cloth, &garment)) {
+        if (isFatalLibraryError(r))
+          return fail(kExitFailure, "drape_context_add_garment_template failed: " + libraryReason(r));
+        return fail(kExitUsage, std::string("the ") + replay::garmentKindName(opt.garment_kind) +
+                                    " garment was refused (" + libraryReason(r) +
+                                    "); try another --particles, --substeps or --garment");
+      }
+    }
+  }
+
   ReplayStats st;
   st.drape_version = drape_version_string();
   st.recording = path;
@@ -186,6 +230,55 @@ int run(int argc, char** argv) {
   if (drape_result r = drape_context_read_body_mesh(ctx.get(), nullptr, nullptr, 0, indices.data(), index_count))
     return fail(kExitFailure, "drape_context_read_body_mesh (indices) failed: " + libraryReason(r));
   const bool watertight = replay::isWatertight(indices, vertex_count);
+
+  // Garment mesh: sizes, indices and rest shape are fixed for the garment; read them once.
+  uint32_t garment_vertices = 0, garment_index_count = 0;
+  std::vector<drape_vec3> garment_positions, garment_normals;
+  std::vector<uint32_t> garment_indices;
+  if (garment) {
+    if (drape_result r = drape_garment_get_mesh_size(garment, &garment_vertices, &garment_index_count))
+      return fail(kExitFailure, "drape_garment_get_mesh_size failed: " + libraryReason(r));
+    garment_positions.resize(garment_vertices);
+    if (opt.write_obj) garment_normals.resize(garment_vertices);
+    garment_indices.resize(garment_index_count);
+    if (drape_result r = drape_garment_read_mesh(garment, nullptr, nullptr, 0, garment_indices.data(),
+                                                 garment_index_count))
+      return fail(kExitFailure, "drape_garment_read_mesh (indices) failed: " + libraryReason(r));
+    std::vector<drape_vec3> rest(garment_vertices);
+    if (drape_result r = drape_garment_read_rest_positions(garment, rest.data(), garment_vertices))
+      return fail(kExitFailure, "drape_garment_read_rest_positions failed: " + libraryReason(r));
+    st.nonfinite += replay::countNonFinite(rest);
+    st.stretch.setMesh(garment_indices, rest);
+
+    drape_cloth_params actual;
+    drape_cloth_params_init(&actual);
+    if (drape_result r = drape_garment_get_params(garment, &actual))
+      return fail(kExitFailure, "drape_garment_get_params failed: " + libraryReason(r));
+    drape_garment_stats gs{};
+    gs.struct_size = sizeof gs;
+    if (drape_result r = drape_garment_get_stats(garment, &gs))
+      return fail(kExitFailure, "drape_garment_get_stats failed: " + libraryReason(r));
+    st.has_garment = true;
+    st.garment_from_obj = !opt.garment_obj.empty();
+    st.garment_kind = st.garment_from_obj ? opt.garment_obj : replay::garmentKindName(opt.garment_kind);
+    st.solver = opt.solver;
+    st.substep_hz = actual.substep_hz;
+    st.particles = garment_vertices;
+    st.garment_triangles = garment_index_count / 3;
+    st.attached = gs.attached;
+    st.cloth_ms.reserve(frames);
+    st.integrate_ms.reserve(frames);
+    st.collide_ms.reserve(frames);
+    st.contacts.reserve(frames);
+    st.substeps.reserve(frames);
+  }
+  // The host's frame time for drape_context_step: this frame's timestamp minus the previous
+  // accepted frame's; the first frame gets one nominal frame period.
+  const double first_dt = std::isfinite(info.nominal_rate_hz) && info.nominal_rate_hz > 0.0f
+                              ? 1.0 / static_cast<double>(info.nominal_rate_hz)
+                              : 1.0 / 30.0;
+  bool have_previous = false;
+  double previous_timestamp = 0.0;
   st.ms_per_frame.reserve(frames);
   st.skeleton_ms.reserve(frames);
   st.body_ms.reserve(frames);
@@ -219,10 +312,18 @@ int run(int argc, char** argv) {
       ++st.rejected_frames;
       continue;
     }
-    if (drape_result r = drape_context_update(ctx.get()))
+    if (garment) {
+      // drape_context_step runs the update, then the cloth. dt within the library's (0, 10] s.
+      const double dt = std::min(std::max(have_previous ? timestamp - previous_timestamp : first_dt, 1e-6), 10.0);
+      if (drape_result r = drape_context_step(ctx.get(), static_cast<float>(dt)))
+        return fail(kExitFailure, "drape_context_step failed on frame " + std::to_string(i) + ": " + libraryReason(r));
+    } else if (drape_result r = drape_context_update(ctx.get())) {
       return fail(kExitFailure, "drape_context_update failed on frame " + std::to_string(i) + ": " + libraryReason(r));
+    }
     const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     st.ms_per_frame.push_back(ms);
+    have_previous = true;
+    previous_timestamp = timestamp;
 
     drape_frame_stats fs_stats{};
     fs_stats.struct_size = sizeof fs_stats;
@@ -261,6 +362,54 @@ int run(int argc, char** argv) {
       const std::string comment = "drape-replay frame " + std::to_string(i) + ", t = " + std::to_string(timestamp) +
                                   " s, " + std::to_string(vertex_count) + " vertices";
       if (!replay::writeObj(obj.string(), positions, normals, indices, comment, error))
+        return fail(kExitFailure, error);
+    }
+
+    if (!garment) continue;
+    drape_garment_stats gs{};
+    gs.struct_size = sizeof gs;
+    if (drape_result r = drape_garment_get_stats(garment, &gs))
+      return fail(kExitFailure, "drape_garment_get_stats failed: " + libraryReason(r));
+    st.nonfinite += static_cast<uint64_t>(!std::isfinite(gs.step_ms)) +
+                    static_cast<uint64_t>(!std::isfinite(gs.integrate_ms)) +
+                    static_cast<uint64_t>(!std::isfinite(gs.collide_ms));
+    st.cloth_ms.push_back(gs.step_ms);
+    st.integrate_ms.push_back(gs.integrate_ms);
+    st.collide_ms.push_back(gs.collide_ms);
+    st.contacts.push_back(gs.contacts);
+    st.substeps.push_back(gs.substeps);
+    st.teleport_resets += gs.teleport_reset ? 1u : 0u;
+    st.nan_resets += gs.nan_reset ? 1u : 0u;
+
+    if (opt.measure_every != 0 && (st.cloth_ms.size() - 1) % opt.measure_every == 0) {
+      drape_garment_accuracy acc{};
+      acc.struct_size = sizeof acc;
+      if (drape_result r = drape_garment_measure(garment, &acc))
+        return fail(kExitFailure, "drape_garment_measure failed on frame " + std::to_string(i) + ": " +
+                                      libraryReason(r));
+      const float measured[] = {acc.max_stretch, acc.p99_stretch, acc.mean_stretch, acc.body_penetration_p99_mm,
+                                acc.body_penetration_max_mm, acc.deeper_than_2mm};
+      for (float v : measured) st.nonfinite += static_cast<uint64_t>(!std::isfinite(v));
+      st.proxy_inside += acc.proxy_inside;
+      st.penetration_p99_mm.push_back(acc.body_penetration_p99_mm);
+      st.penetration_max_mm.push_back(acc.body_penetration_max_mm);
+      st.deeper_than_2mm.push_back(acc.deeper_than_2mm);
+    }
+
+    if (drape_result r = drape_garment_read_mesh(garment, garment_positions.data(),
+                                                 opt.write_obj ? garment_normals.data() : nullptr, garment_vertices,
+                                                 nullptr, 0))
+      return fail(kExitFailure, "drape_garment_read_mesh failed on frame " + std::to_string(i) + ": " +
+                                    libraryReason(r));
+    st.nonfinite += replay::countNonFinite(garment_positions) + replay::countNonFinite(garment_normals);
+    st.stretch.addFrame(garment_positions);
+
+    if (opt.write_obj) {
+      const fs::path obj = fs::path(opt.out_dir) / replay::garmentObjFileName(i);
+      const std::string comment = "drape-replay garment " + st.garment_kind + ", frame " + std::to_string(i) +
+                                  ", t = " + std::to_string(timestamp) + " s, " + std::to_string(garment_vertices) +
+                                  " vertices";
+      if (!replay::writeObj(obj.string(), garment_positions, garment_normals, garment_indices, comment, error))
         return fail(kExitFailure, error);
     }
   }

@@ -2,6 +2,7 @@
 // out-of-range numbers are errors (exit 2), never silently ignored or clamped.
 #include "options.h"
 
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -34,6 +35,22 @@ bool parseUint(const std::string& text, unsigned long lo, unsigned long hi, uint
   out = static_cast<uint32_t>(v);
   return true;
 }
+
+bool endsWithObj(const std::string& text) {
+  if (text.size() < 5) return false;  // at least one character before ".obj"
+  std::string ext = text.substr(text.size() - 4);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".obj";
+}
+
+struct GarmentName { const char* name; int32_t kind; };
+constexpr GarmentName kGarmentNames[] = {
+    {"tshirt", DRAPE_GARMENT_TSHIRT},   {"longsleeve", DRAPE_GARMENT_LONG_SLEEVE},
+    {"skirt", DRAPE_GARMENT_SKIRT},     {"dress", DRAPE_GARMENT_DRESS},
+    {"trousers", DRAPE_GARMENT_TROUSERS}};
+
+// Substeps per 1/30 s frame: substep_hz = 30 * N must stay within the library's [30, 20000].
+constexpr unsigned long kMaxSubsteps = 666;
 
 bool parseLayout(const std::string& text, int32_t& out) {
   if (text == "auto") out = DRAPE_LAYOUT_AUTO;
@@ -187,6 +204,58 @@ bool parseOptions(int argc, const char* const* argv, Options& o, std::string& er
         error = "--fidelity-every '" + value + "' is not a whole number >= 0 (0 turns the measurement off)";
         return false;
       }
+    } else if (name == "--garment") {
+      if (!takeValue()) return false;
+      o.garment_none = false;
+      o.garment_obj.clear();
+      bool known = false;
+      for (const GarmentName& g : kGarmentNames)
+        if (value == g.name) {
+          o.garment_kind = g.kind;
+          known = true;
+        }
+      if (value == "none") {
+        o.garment_none = true;
+      } else if (!known) {
+        if (!endsWithObj(value)) {
+          error = "--garment '" + value +
+                  "' is not tshirt, longsleeve, skirt, dress, trousers, none or a path ending in .obj "
+                  "(e.g. --garment skirt or --garment shirt.obj)";
+          return false;
+        }
+        o.garment_obj = value;
+      }
+    } else if (name == "--particles") {
+      if (!takeValue()) return false;
+      if (!parseUint(value, 200, 200000, o.particles)) {
+        error = "--particles '" + value + "' is not a whole number in [200, 200000] (e.g. --particles 8000)";
+        return false;
+      }
+    } else if (name == "--solver") {
+      if (!takeValue()) return false;
+      if (value == "xpbd") {
+        o.solver = DRAPE_SOLVER_XPBD;
+      } else if (value == "massspring") {
+        o.solver = DRAPE_SOLVER_MASS_SPRING;
+      } else {
+        error = "--solver '" + value + "' is not 'xpbd' or 'massspring' (the paper's mass-spring)";
+        return false;
+      }
+      o.solver_given = true;
+    } else if (name == "--substeps") {
+      if (!takeValue()) return false;
+      if (!parseUint(value, 1, kMaxSubsteps, o.substeps)) {
+        error = "--substeps '" + value + "' is not a whole number in [1, " + std::to_string(kMaxSubsteps) +
+                "] (substeps per 1/30 s frame, e.g. --substeps 10 for 300 Hz)";
+        return false;
+      }
+    } else if (name == "--measure-every" || name == "--garment-every") {
+      if (!takeValue()) return false;
+      if (!parseUint(value, 0, 0xffffffffUL, o.measure_every)) {
+        error = name + " '" + value + "' is not a whole number >= 0 (1 = every frame; 0 turns the measurement off)";
+        return false;
+      }
+      o.measure_given = true;
     } else if (name == "--out") {
       if (!takeValue()) return false;
       if (value.empty()) {
@@ -207,7 +276,29 @@ bool parseOptions(int argc, const char* const* argv, Options& o, std::string& er
       return false;
     }
   }
+  // Garment options that the chosen garment would silently ignore are mistakes.
+  if (o.garment_none && (o.particles != 0 || o.solver_given || o.substeps != 0 || o.measure_given)) {
+    error = std::string(o.particles != 0 ? "--particles" : o.solver_given ? "--solver"
+                        : o.substeps != 0 ? "--substeps" : "--measure-every") +
+            " has no effect with --garment none; drop it or choose a garment";
+    return false;
+  }
+  if (!o.garment_obj.empty() && o.particles != 0) {
+    error = "--particles sets a template garment's resolution; an OBJ garment keeps its own vertices, "
+            "so drop --particles or use --garment tshirt|longsleeve|skirt|dress|trousers";
+    return false;
+  }
   return true;
+}
+
+const char* garmentKindName(int32_t kind) {
+  for (const GarmentName& g : kGarmentNames)
+    if (g.kind == kind) return g.name;
+  return "unknown";
+}
+
+const char* solverName(int32_t solver) {
+  return solver == DRAPE_SOLVER_MASS_SPRING ? "massspring" : "xpbd";
 }
 
 std::string resolveStatsPath(const Options& o) {
@@ -222,11 +313,13 @@ std::string resolveStatsPath(const Options& o) {
 
 std::string helpText() {
   return
-      "drape-replay: replays a skeleton recording through Drape and reports timing and mesh checks.\n"
+      "drape-replay: replays a skeleton recording through Drape, dresses the person in a garment and\n"
+      "reports timing, mesh checks and cloth accuracy.\n"
       "\n"
       "Usage: drape-replay [options]\n"
       "With no options it replays the bundled Kinect v2 recording (Ges01_wavehand.csv) on the\n"
-      "default body (1.70 m, 65 kg) and writes body_NNNNN.obj files and stats.json into ./drape-out.\n"
+      "default body (1.70 m, 65 kg) in a 2 000-particle T-shirt and writes body_NNNNN.obj,\n"
+      "garment_NNNNN.obj and stats.json into ./drape-out.\n"
       "\n"
       "Options (\"--opt value\" or \"--opt=value\"):\n"
       "  --recording PATH      Kinect v2 CSV, BVH or Drape .drec file (format detected from content)\n"
@@ -239,8 +332,18 @@ std::string helpText() {
       "  --proxy-rule R        tracking ellipsoids: drape (default) or paper (the paper's eq. 5-6)\n"
       "  --fidelity-every N    measure how closely the ellipsoids fit the body every N frames\n"
       "                        (default 10; 0 = never; about 10 ms per measurement)\n"
-      "  --out DIR             output directory for body_NNNNN.obj and stats.json (default ./drape-out;\n"
-      "                        created if missing)\n"
+      "  --garment G           tshirt (default), longsleeve, skirt, dress, trousers, none (no cloth:\n"
+      "                        push + update only), or PATH.obj (a garment mesh, e.g. from MakeHuman)\n"
+      "  --particles N         template garment resolution, in [200, 200000] (default 2000)\n"
+      "  --solver S            xpbd (default) or massspring (the paper's mass-spring; it needs\n"
+      "                        ~3 kHz, so it runs at 2880 Hz unless --substeps is given)\n"
+      "  --substeps N          cloth substeps per 1/30 s frame, in [1, 666]: substep_hz = 30 * N\n"
+      "                        (default 10 = 300 Hz for xpbd, 96 = 2880 Hz for massspring)\n"
+      "  --measure-every N     measure the garment's accuracy (stretch, ellipsoid and body\n"
+      "                        penetration; ~1 ms per 1 000 particles) every N frames (default 1;\n"
+      "                        0 = never). Alias: --garment-every\n"
+      "  --out DIR             output directory for body_NNNNN.obj, garment_NNNNN.obj and stats.json\n"
+      "                        (default ./drape-out; created if missing)\n"
       "  --no-obj              do not write OBJ files (for timing)\n"
       "  --stats FILE.json     stats file (default DIR/stats.json; with --no-obj and no --out: none)\n"
       "  --quiet, -q           no summary on stdout\n"
@@ -251,6 +354,11 @@ std::string helpText() {
       "  drape-replay --recording take.csv --frames 100 --out /tmp/take\n"
       "  drape-replay --body sex=female,height_m=1.62,weight_kg=58,waist_mm=720 --no-obj --stats s.json\n"
       "  drape-replay --recording scaled_131_03.bvh --ring-points 32 --no-obj --quiet --stats bvh.json\n"
+      "  drape-replay --garment dress --particles 8000 --no-obj --stats dress.json\n"
+      "  drape-replay --solver massspring --garment tshirt --frames 60 --no-obj --stats paper.json\n"
+      "  drape-replay --garment ../shared/data/garments_makehuman_cc0/female_casualsuit02.obj \\\n"
+      "               --body sex=female --frames 100\n"
+      "  drape-replay --garment none --no-obj --stats body-only.json\n"
       "\n"
       "Exit codes: 0 replay ran (rejected frames are counted, not fatal); 2 bad arguments or an\n"
       "unreadable/unparsable recording; 1 any other failure. Details: docs/replay.md\n";

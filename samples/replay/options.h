@@ -17,6 +17,19 @@ struct Options {
   uint32_t ring_points = 0;        // 0: the library default
   int32_t proxy_rule = DRAPE_PROXY_RULE_DRAPE;
   uint32_t fidelity_every = 10;    // measure proxy fidelity every N updated frames; 0: never
+
+  // The garment (--garment). kind is a drape_garment_kind for a template; garment_none turns the
+  // cloth off (push + drape_context_update, as before garments existed); a non-empty garment_obj
+  // is an OBJ file added with drape_context_add_garment_obj_file and the default drape_mesh_fit.
+  bool garment_none = false;
+  int32_t garment_kind = DRAPE_GARMENT_TSHIRT;
+  std::string garment_obj;
+  uint32_t particles = 0;          // 0: the library's template default (drape_garment_template_init)
+  int32_t solver = DRAPE_SOLVER_XPBD;
+  bool solver_given = false;
+  uint32_t substeps = 0;           // per 1/30 s frame; 0: the library default (or 2880 Hz for massspring)
+  uint32_t measure_every = 1;      // drape_garment_measure every N stepped frames; 0: never
+  bool measure_given = false;
   std::string out_dir = "drape-out";
   bool out_given = false;
   bool write_obj = true;
@@ -32,6 +45,11 @@ bool parseOptions(int argc, const char* const* argv, Options& out, std::string& 
 // Where the stats JSON goes: --stats if given, else DIR/stats.json when OBJs are written or --out
 // was given, else nowhere (empty string).
 std::string resolveStatsPath(const Options& options);
+
+// The name of a garment template kind as --garment spells it ("tshirt", "longsleeve", ...).
+const char* garmentKindName(int32_t kind);
+// "xpbd" or "massspring".
+const char* solverName(int32_t solver);
 
 // The --help text.
 std::string helpText();

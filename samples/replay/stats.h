@@ -4,6 +4,8 @@
 
 #include <drape/drape.h>
 
+#include "stretch.h"
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -39,6 +41,25 @@ struct ReplayStats {
   uint32_t proxy_count = 0;
   int32_t proxy_rule = DRAPE_PROXY_RULE_DRAPE;
   std::vector<double> body_to_proxy_p95, proxy_to_body_p95, fit_max, outside_fraction;
+
+  // The garment (has_garment false: --garment none, every key below stays empty/0).
+  bool has_garment = false;
+  std::string garment_kind;        // template name or the OBJ path
+  bool garment_from_obj = false;
+  int32_t solver = DRAPE_SOLVER_XPBD;
+  double substep_hz = 0.0;         // drape_garment_get_params after adding
+  uint32_t particles = 0;          // garment vertex count
+  uint32_t garment_triangles = 0;
+  uint32_t attached = 0;
+  uint32_t teleport_resets = 0;    // stepped frames with drape_garment_stats.teleport_reset
+  uint32_t nan_resets = 0;         // ... with nan_reset
+  // Per stepped frame (drape_garment_get_stats after the step).
+  std::vector<double> cloth_ms, integrate_ms, collide_ms, contacts, substeps;
+  // Stretch of every structural edge of every stepped frame, from the positions read back.
+  StretchAccumulator stretch;
+  // Per measured frame (drape_garment_measure, --measure-every).
+  uint64_t proxy_inside = 0;       // summed over measured frames
+  std::vector<double> penetration_p99_mm, penetration_max_mm, deeper_than_2mm;
 };
 
 // Median (mean of the two middle values for an even count) and nearest-rank percentile

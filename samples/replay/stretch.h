@@ -1,0 +1,45 @@
+// Garment stretch pooled over a whole replay: every structural edge (each undirected edge of the
+// garment's triangles, once) of every frame, against its rest length. Memory is bounded whatever
+// the run's length: a fixed-bin histogram of the stretch |len| / rest - 1 in 0.01 % bins from
+// -100 % to +1000 %, an overflow count above, and the exact maximum.
+#pragma once
+
+#include <drape/drape.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace replay {
+
+class StretchAccumulator {
+ public:
+  static constexpr double kBinWidth = 1e-4;  // 0.01 %
+  static constexpr double kLow = -1.0;       // an edge of length 0
+  static constexpr double kHigh = 10.0;      // +1000 %; above: the overflow count
+
+  // The edges of the triangle list (each undirected edge once) and their rest lengths from
+  // `rest` (drape_garment_read_rest_positions). Edges of rest length 0 are left out.
+  void setMesh(const std::vector<uint32_t>& indices, const std::vector<drape_vec3>& rest);
+
+  // Adds one frame's stretch samples. Edges with a non-finite length are skipped (the caller
+  // counts non-finite positions).
+  void addFrame(const std::vector<drape_vec3>& positions);
+
+  size_t edgeCount() const { return a_.size(); }
+  uint64_t samples() const { return samples_; }
+  // NaN when there are no samples.
+  double max() const;
+  // Nearest-rank p-th percentile (p in (0, 100]) of all samples: the upper edge of the bin holding
+  // that rank (so at most 0.01 % above the exact value), never above max(). NaN when empty.
+  double percentile(double p) const;
+
+ private:
+  std::vector<uint32_t> a_, b_;
+  std::vector<float> rest_;
+  std::vector<uint64_t> bins_;
+  uint64_t overflow_ = 0;
+  uint64_t samples_ = 0;
+  double max_ = 0.0;
+};
+
+}  // namespace replay
