@@ -100,10 +100,10 @@ struct SolverOf : GarmentSim::Solver {
 };
 
 struct XpbdFace final : SolverOf<XpbdSolver> {
-  using SolverOf::SolverOf;
+  explicit XpbdFace(GarmentTopology t) : SolverOf(std::move(t)) { s.setTimingEnabled(true); }
   bool setParams(const GarmentSimParams& p, std::string& err) override { return s.setParams(p.xpbd, err); }
   void step(float dt, int n) override { s.step(dt, n); }
-  double collideMs() const override { return 0.0; }  // XpbdSolver does not time its collision yet
+  double collideMs() const override { return s.lastTimings().collision_ns * 1e-6; }
 };
 
 struct MassSpringFace final : SolverOf<MassSpringSolver> {
@@ -180,7 +180,7 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
   g->masks_.resize(g->mesh_.positions.size());
   for (size_t i = 0; i < g->masks_.size(); ++i)
     g->masks_[i] = maskForChain(nearestChain(body_rest, g->mesh_.positions[i]));
-  // PENDING-GROUPS g->collider_.setGroups(g->groups_, g->masks_.data());
+  g->collider_.setGroups(g->groups_, g->masks_.data());
   g->kind_ = solver;
   if (solver == ClothSolverKind::Xpbd) g->solver_ = std::make_unique<XpbdFace>(g->topology_);
   else g->solver_ = std::make_unique<MassSpringFace>(g->topology_);

@@ -33,6 +33,10 @@ namespace drape {
 enum class ClothSolverKind : int { Xpbd = 0, MassSpring = 1 };
 
 struct GarmentSimParams {
+  // Garments limit the collider's escape step to 1 cm: cloth pinched between touching body parts
+  // stays pinched instead of being pulled through one of them (proxies/collision.h).
+  GarmentSimParams() { xpbd.collision.max_escape_m = 0.01f; }
+
   float substep_hz = 300.0f;    // substeps per simulated second, [30, 20000]
   int max_substeps = 200;       // per step, [1, 1000]; a longer step gets bigger substeps
   float max_step_s = 0.1f;      // a host frame longer than this simulates only this, (0, 1]

@@ -319,16 +319,21 @@ void EllipsoidCollider::refreshQuick(int k) {
 #endif
 
 DRAPE_ALWAYS_INLINE bool EllipsoidCollider::gather(const Vec3& lo, const Vec3& hi, bool use_grid,
-                                                   Candidates& c) const {
+                                                   const uint64_t* allowed, Candidates& c) const {
   if (!overlaps(lo, hi, grid_min_, grid_max_)) return false;  // outside every swept box
   c.all = !use_grid;
+  c.allowed = allowed;
   if (c.all) return true;
   c.lo = cellsOf(lo, cell_origin_, cell_scale_, cell_top_);
   c.hi = cellsOf(hi, cell_origin_, cell_scale_, cell_top_);
   if ((c.lo == c.hi).all()) {  // the usual case: one cell
     const uint64_t* cell =
         &cells_[static_cast<size_t>(((c.lo[2] * dims_[1] + c.lo[1]) * dims_[0] + c.lo[0]) * words_)];
-    for (int w = 0; w < words_; ++w) c.mask[w] = cell[w];
+    if (allowed) {
+      for (int w = 0; w < words_; ++w) c.mask[w] = cell[w] & allowed[w];
+    } else {
+      for (int w = 0; w < words_; ++w) c.mask[w] = cell[w];
+    }
     return true;
   }
   for (int w = 0; w < words_; ++w) c.mask[w] = 0;
@@ -340,6 +345,8 @@ DRAPE_ALWAYS_INLINE bool EllipsoidCollider::gather(const Vec3& lo, const Vec3& h
       }
     }
   }
+  if (allowed)
+    for (int w = 0; w < words_; ++w) c.mask[w] &= allowed[w];
   return true;
 }
 
@@ -353,7 +360,8 @@ template <class F>
 void EllipsoidCollider::iterate(const Candidates& c, F&& f) const {
   if (c.all) {
     const int n = count();
-    for (int k = 0; k < n; ++k) f(k);
+    for (int k = 0; k < n; ++k)
+      if (!c.allowed || ((c.allowed[k >> 6] >> (k & 63)) & 1u)) f(k);
     return;
   }
   for (int w = 0; w < words_; ++w) {
@@ -367,14 +375,16 @@ void EllipsoidCollider::iterate(const Candidates& c, F&& f) const {
 }
 
 template <class F>
-void EllipsoidCollider::forCandidates(const Vec3& lo, const Vec3& hi, bool use_grid, F&& f) const {
+void EllipsoidCollider::forCandidates(const Vec3& lo, const Vec3& hi, bool use_grid, const uint64_t* allowed,
+                                      F&& f) const {
   Candidates c;
-  if (gather(lo, hi, use_grid, c)) iterate(c, f);
+  if (gather(lo, hi, use_grid, allowed, c)) iterate(c, f);
 }
 
-int EllipsoidCollider::firstContaining(const Vec3& x, bool use_grid, CollisionStats& st) const {
+int EllipsoidCollider::firstContaining(const Vec3& x, bool use_grid, const uint64_t* allowed,
+                                       CollisionStats& st) const {
   int found = -1;
-  forCandidates(x, x, use_grid, [&](int k) {
+  forCandidates(x, x, use_grid, allowed, [&](int k) {
     if (found >= 0) return;
     const Quick& qk = quick_[static_cast<size_t>(k)];
     const Vec4 x4 = lift(x);
@@ -420,8 +430,8 @@ Vec3 EllipsoidCollider::slideFromEntry(const Shape& s, const Vec3& qe, const Vec
   return x;
 }
 
-void EllipsoidCollider::escape(Vec3& x, ContactResponse mode, bool use_grid,
-                               CollisionStats& st) const {
+void EllipsoidCollider::escape(Vec3& x, ContactResponse mode, bool use_grid, const uint64_t* allowed,
+                               float max_escape, CollisionStats& st) const {
   // x is inside one or more overlapping ellipsoids after the sequential passes (pushes out of
   // one keep landing in another). Candidates: the response target of each ellipsoid containing
   // x (up to 8). Take the nearest target that is outside every ellipsoid; if there is none,
@@ -432,7 +442,7 @@ void EllipsoidCollider::escape(Vec3& x, ContactResponse mode, bool use_grid,
   int containing[kMaxCandidates];
   Vec3 targets[kMaxCandidates];
   int m = 0;
-  forCandidates(x, x, use_grid, [&](int k) {
+  forCandidates(x, x, use_grid, allowed, [&](int k) {
     if (m == kMaxCandidates) return;
     const Shape& s = shapes_[static_cast<size_t>(k)];
     if (!containsPoint(s.end_min, s.end_max, x)) return;
@@ -444,16 +454,18 @@ void EllipsoidCollider::escape(Vec3& x, ContactResponse mode, bool use_grid,
     targets[m] = respond(s, x, q, r2, mode, qc);
     containing[m++] = k;
   });
-  float best = std::numeric_limits<float>::infinity();
+  // Beyond max_escape the particle stays (pinched): best starts at the limit.
+  const float limit2 = max_escape > 0.0f ? max_escape * max_escape : std::numeric_limits<float>::infinity();
+  float best = limit2;
   Vec3 best_x = x;
   for (int i = 0; i < m; ++i) {
     const float d = (targets[i] - x).squaredNorm();
-    if (d < best && firstContaining(targets[i], use_grid, st) < 0) {
+    if (d < best && firstContaining(targets[i], use_grid, allowed, st) < 0) {
       best = d;
       best_x = targets[i];
     }
   }
-  if (best < std::numeric_limits<float>::infinity()) {
+  if (best < limit2) {
     x = best_x;
     return;
   }
@@ -467,7 +479,7 @@ void EllipsoidCollider::escape(Vec3& x, ContactResponse mode, bool use_grid,
     bool out = false;
     for (int jump = 0; jump <= n && t * t < best; ++jump) {
       const Vec3 p = x + t * dir;
-      const int k = firstContaining(p, use_grid, st);
+      const int k = firstContaining(p, use_grid, allowed, st);
       if (k < 0) {
         out = true;
         break;
@@ -533,7 +545,8 @@ void EllipsoidCollider::contact(const Shape& s, const Eigen::Vector4f& q1_4, flo
 }
 
 void EllipsoidCollider::resolveParticle(Vec3& x, const Vec3& x0, bool has_prev,
-                                        const CollisionParams& p, CollisionStats& st) const {
+                                        const CollisionParams& p, const uint64_t* allowed,
+                                        CollisionStats& st) const {
   const bool cont = p.continuous && has_prev;
   const bool friction = has_prev && (p.static_friction > 0.0f || p.kinetic_friction > 0.0f);
   const bool use_grid = p.broad_phase && grid_;
@@ -547,7 +560,7 @@ void EllipsoidCollider::resolveParticle(Vec3& x, const Vec3& x0, bool has_prev,
   const Vec3 x_end = x;
   bool moved = false;
   Candidates first;
-  if (!gather(lo, hi, use_grid, first)) return;
+  if (!gather(lo, hi, use_grid, allowed, first)) return;
   const Vec4 lo4 = lift(lo), hi4 = lift(hi), x0_4 = lift(x0), x_end4 = lift(x_end);
   iterate(first, [&](int k) DRAPE_LAMBDA_INLINE {
     const Quick& qk = quick_[static_cast<size_t>(k)];
@@ -586,7 +599,7 @@ void EllipsoidCollider::resolveParticle(Vec3& x, const Vec3& x0, bool has_prev,
     Candidates again;
     const Candidates* c = &first;
     if (!covers(first, xp)) {
-      if (!gather(xp, xp, use_grid, again)) break;
+      if (!gather(xp, xp, use_grid, allowed, again)) break;
       c = &again;
     }
     const Vec4 xp4 = lift(xp);
@@ -603,10 +616,22 @@ void EllipsoidCollider::resolveParticle(Vec3& x, const Vec3& x0, bool has_prev,
     });
   }
   // Guarantee: if the last pass moved the particle, check it; still inside -> escape step.
-  if (moved && firstContaining(x, use_grid, st) >= 0) {
-    escape(x, p.response, use_grid, st);
+  if (moved && firstContaining(x, use_grid, allowed, st) >= 0) {
+    escape(x, p.response, use_grid, allowed, p.max_escape_m, st);
     ++st.escapes;
   }
+}
+
+void EllipsoidCollider::setGroups(const std::vector<uint8_t>& ellipsoid_groups, const uint8_t* particle_masks) {
+  groups_ = ellipsoid_groups;
+  particle_masks_ = particle_masks;
+  allowed_.clear();
+  if (groups_.empty() || !particle_masks_ || groups_.size() > static_cast<size_t>(kMaxGridEllipsoids)) return;
+  constexpr size_t kWords = kMaxGridEllipsoids / 64;
+  allowed_.assign(256 * kWords, 0);
+  for (size_t mask = 0; mask < 256; ++mask)
+    for (size_t k = 0; k < groups_.size(); ++k)
+      if (groups_[k] & mask) allowed_[mask * kWords + k / 64] |= uint64_t{1} << (k % 64);
 }
 
 CollisionStats EllipsoidCollider::collide(Eigen::Vector4f* positions,
@@ -619,6 +644,8 @@ CollisionStats EllipsoidCollider::collide(Eigen::Vector4f* positions,
   p.static_friction = p.static_friction > 0.0f ? std::min(p.static_friction, 1e6f) : 0.0f;
   p.kinetic_friction = p.kinetic_friction > 0.0f ? std::min(p.kinetic_friction, 1e6f) : 0.0f;
   const bool swept = p.continuous && previous != nullptr;
+  const bool grouped = particle_masks_ != nullptr && !allowed_.empty() &&
+                       groups_.size() == shapes_.size() && shapes_.size() <= static_cast<size_t>(kMaxGridEllipsoids);
   for (size_t i = 0; i < count; ++i) {
     if (!(positions[i].w() > 0.0f)) continue;
     const Vec3 x = positions[i].head<3>();
@@ -638,7 +665,9 @@ CollisionStats EllipsoidCollider::collide(Eigen::Vector4f* positions,
       if (!has_prev) x0 = x;
     }
     Vec3 y = x;
-    resolveParticle(y, x0, has_prev, p, st);
+    const uint64_t* allowed =
+        grouped ? &allowed_[static_cast<size_t>(particle_masks_[i]) * (kMaxGridEllipsoids / 64)] : nullptr;
+    resolveParticle(y, x0, has_prev, p, allowed, st);
     if (y != x) positions[i].head<3>() = y;
   }
   return st;

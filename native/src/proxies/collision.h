@@ -27,6 +27,12 @@ struct CollisionParams {
   float kinetic_friction = 0.4f;  // mu_k: otherwise slip is reduced by mu_k * depth
   bool continuous = true;         // swept test between the substep's start and end
   bool broad_phase = true;        // grid culling; off = test every ellipsoid (same results)
+  // The escape step (a particle still inside after the sequential passes) moves a particle at
+  // most this far; a particle that would have to jump farther is left where the passes put it.
+  // Such a particle is pinched where two body parts touch and their ellipsoids overlap: the only
+  // way out is through one of the parts, which tears the cloth apart. <= 0: no limit (then every
+  // particle is guaranteed outside every ellipsoid). Garments use 1 cm (GarmentSimParams).
+  float max_escape_m = 0.0f;
 };
 
 struct CollisionStats {
@@ -68,6 +74,14 @@ class EllipsoidCollider {
                          const CollisionParams& params) const;
 
   int count() const { return static_cast<int>(shapes_.size()); }
+
+  // Collision groups. ellipsoid_groups: one bit set per ellipsoid (its group, e.g. 1 << body
+  // chain), in the order setEllipsoids receives them; particle_masks: one byte per particle, the
+  // groups it collides with (kept by the caller, read by collide() for particle i = masks[i]).
+  // A particle never collides with an ellipsoid outside its mask. Empty groups or null masks: every
+  // particle collides with every ellipsoid. Needs count() <= kMaxGridEllipsoids at collide time
+  // (otherwise groups are ignored).
+  void setGroups(const std::vector<uint8_t>& ellipsoid_groups, const uint8_t* particle_masks);
   float margin() const { return margin_; }
   // The inflated ellipsoid at the substep end (what a particle must end outside of).
   Ellipsoid inflatedEnd(int i) const;
@@ -104,20 +118,22 @@ class EllipsoidCollider {
     Mask mask;
     Eigen::Array4i lo, hi;  // cell range (w lane unused)
     bool all;
+    const uint64_t* allowed;  // with `all`: only these (collision groups); null = every one
   };
-  // False when the box misses every swept box. Otherwise fills c.
-  bool gather(const Vec3& lo, const Vec3& hi, bool use_grid, Candidates& c) const;
+  // False when the box misses every swept box. Otherwise fills c. allowed: the particle's
+  // collision-group mask of ellipsoids (words_ words) or null.
+  bool gather(const Vec3& lo, const Vec3& hi, bool use_grid, const uint64_t* allowed, Candidates& c) const;
   // Whether c's cells include the cell of p (then c's candidates include p's).
   bool covers(const Candidates& c, const Vec3& p) const;
   // Calls f(k) for the candidates in increasing k.
   template <class F>
   void iterate(const Candidates& c, F&& f) const;
   template <class F>
-  void forCandidates(const Vec3& lo, const Vec3& hi, bool use_grid, F&& f) const;
+  void forCandidates(const Vec3& lo, const Vec3& hi, bool use_grid, const uint64_t* allowed, F&& f) const;
   // First ellipsoid (in index order) containing x by more than the tolerance, or -1.
-  int firstContaining(const Vec3& x, bool use_grid, CollisionStats& stats) const;
+  int firstContaining(const Vec3& x, bool use_grid, const uint64_t* allowed, CollisionStats& stats) const;
   void resolveParticle(Vec3& x, const Vec3& x0, bool has_prev, const CollisionParams& p,
-                       CollisionStats& stats) const;
+                       const uint64_t* allowed, CollisionStats& stats) const;
   Vec3 respond(const Shape& s, const Vec3& x, const Vec3& q, float r2, ContactResponse mode,
                Vec3& q_contact) const;
   void refreshQuick(int k);
@@ -125,7 +141,8 @@ class EllipsoidCollider {
                float q0sq, bool inside, bool cont, bool friction, const Vec3& x0,
                const CollisionParams& p, Vec3& x, CollisionStats& st) const;
   Vec3 slideFromEntry(const Shape& s, const Vec3& qe, const Vec3& q1, Vec3& q_contact) const;
-  void escape(Vec3& x, ContactResponse mode, bool use_grid, CollisionStats& stats) const;
+  void escape(Vec3& x, ContactResponse mode, bool use_grid, const uint64_t* allowed, float max_escape,
+              CollisionStats& stats) const;
 
   std::vector<Shape> shapes_;
   std::vector<Quick> quick_;
@@ -137,6 +154,11 @@ class EllipsoidCollider {
   Eigen::Array4f cell_origin_ = Eigen::Array4f::Zero(), cell_scale_ = Eigen::Array4f::Zero(),
                  cell_top_ = Eigen::Array4f::Zero();
   float margin_ = kDefaultMargin;
+  // Collision groups (setGroups): group bit per ellipsoid, and for each of the 256 particle masks
+  // the ellipsoids it may touch (kMaxGridEllipsoids / 64 words each).
+  std::vector<uint8_t> groups_;
+  std::vector<uint64_t> allowed_;
+  const uint8_t* particle_masks_ = nullptr;
 };
 
 }  // namespace drape
