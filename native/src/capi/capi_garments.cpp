@@ -213,13 +213,14 @@ drape_result toFitParams(const char* fn, const drape_mesh_fit* fit, drape::ObjFi
 
 // Dresses `mesh` on the context's rest body and hands out a handle.
 drape_result adopt(const char* fn, Context& ctx, const drape::GarmentMesh& mesh, const drape_garment_desc& d,
-                   const drape::GarmentSimParams& sim, drape_garment** out) {
+                   const drape::GarmentSimParams& sim, drape_garment** out, bool cut_from_dressed) {
   drape::TopologyParams tp;
   tp.area_density = d.area_density;
   tp.max_tethers_per_particle = static_cast<int>(d.max_tethers);
   std::string err;
   auto g = GarmentSim::create(mesh, tp, static_cast<drape::ClothSolverKind>(d.solver), sim, d.dress_time_s,
-                              ctx.restBody(), ctx.restEllipsoids(), ctx.restEllipsoidChains(), err);
+                              ctx.restBody(), ctx.restEllipsoids(), ctx.restEllipsoidChains(), err,
+                              cut_from_dressed);
   if (!g) return fail(DRAPE_ERROR_INVALID_ARGUMENT, std::string(fn) + ": " + err);
   GarmentSim* raw = g.get();
   void* token = registerHandle(HandleKind::Garment, raw);
@@ -238,7 +239,7 @@ drape_result addFitted(const char* fn, Context& ctx, const drape::ObjMesh& obj, 
   std::string err;
   if (!drape::fitObjGarment(obj, fp, ctx.restBody(), mesh, err))
     return fail(DRAPE_ERROR_INVALID_ARGUMENT, std::string(fn) + ": " + err);
-  return adopt(fn, ctx, mesh, d, sim, out);
+  return adopt(fn, ctx, mesh, d, sim, out, /*cut_from_dressed=*/true);
 }
 
 }  // namespace
@@ -335,7 +336,7 @@ DRAPE_API drape_result DRAPE_CALL drape_context_add_garment_template(drape_conte
     std::string err;
     if (!drape::makeGarmentTemplate(ctx->restBody(), tp, mesh, err))
       return fail(DRAPE_ERROR_INVALID_ARGUMENT, std::string(fn) + ": " + err);
-    return adopt(fn, *ctx, mesh, d, sim, out_garment);
+    return adopt(fn, *ctx, mesh, d, sim, out_garment, /*cut_from_dressed=*/false);
   });
 }
 

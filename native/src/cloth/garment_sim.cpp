@@ -20,6 +20,8 @@ double msSince(Clock::time_point t0) {
 
 // Frames of settling and of dressing run at this rate (the recording rate of a Kinect).
 constexpr float kSettleFrameS = 1.0f / 30.0f;
+// Dressing starts with the body at this fraction of its size (see GarmentSim::create).
+constexpr float kDressStartScale = 0.6f;
 // Soft choice of skinning segment (as the OBJ fit's default): see cloth/ring_skin.h.
 constexpr float kSkinBlendM = 0.015f;
 
@@ -118,6 +120,18 @@ struct MassSpringFace final : SolverOf<MassSpringSolver> {
   double collideMs() const override { return s.lastCollideMs(); }
 };
 
+std::unique_ptr<GarmentSim::Solver> makeSolver(ClothSolverKind kind, const GarmentTopology& t) {
+  if (kind == ClothSolverKind::Xpbd) return std::make_unique<XpbdFace>(t);
+  return std::make_unique<MassSpringFace>(t);
+}
+
+std::vector<float> flatten(const std::vector<Vec3>& v) {
+  std::vector<float> flat(v.size() * 3);
+  for (size_t i = 0; i < v.size(); ++i)
+    for (int a = 0; a < 3; ++a) flat[3 * i + static_cast<size_t>(a)] = v[i][a];
+  return flat;
+}
+
 }  // namespace
 
 GarmentSim::~GarmentSim() = default;
@@ -127,7 +141,7 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
                                                float dress_time_s, const BodyModel& body_rest,
                                                const std::vector<Ellipsoid>& rest_ellipsoids,
                                                const std::vector<int>& ellipsoid_chains,
-                                               std::string& err) {
+                                               std::string& err, bool cut_from_dressed) {
   if (std::string e = validate(params); !e.empty()) {
     err = e;
     return nullptr;
@@ -149,9 +163,7 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
   }
   TopologyParams tp = topo;
   tp.pinned = mesh.pinned;
-  std::vector<float> flat(mesh.positions.size() * 3);
-  for (size_t i = 0; i < mesh.positions.size(); ++i)
-    for (int a = 0; a < 3; ++a) flat[3 * i + static_cast<size_t>(a)] = mesh.positions[i][a];
+  const std::vector<float> flat = flatten(mesh.positions);
   std::unique_ptr<GarmentSim> g(new GarmentSim());
   if (!buildGarmentTopology(flat.data(), mesh.positions.size(), mesh.indices.data(), mesh.indices.size(),
                             tp, g->topology_, err))
@@ -182,8 +194,7 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
     g->masks_[i] = maskForChain(nearestChain(body_rest, g->mesh_.positions[i]));
   g->collider_.setGroups(g->groups_, g->masks_.data());
   g->kind_ = solver;
-  if (solver == ClothSolverKind::Xpbd) g->solver_ = std::make_unique<XpbdFace>(g->topology_);
-  else g->solver_ = std::make_unique<MassSpringFace>(g->topology_);
+  g->solver_ = makeSolver(solver, g->topology_);
   if (!g->setParams(params, err)) return nullptr;
 
   g->pelvis_ring_ = body_rest.chainFirstRing(Chain::Torso);
@@ -193,18 +204,64 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
   g->seen_ellipsoids_ = rest_ellipsoids;
   g->pinTargets(body_rest, g->seen_pins_);
 
-  // Dressing: every free particle outside the inflated rest ellipsoids, then settle on them.
-  std::vector<Eigen::Vector4f> x(mesh.positions.size());
-  for (size_t i = 0; i < x.size(); ++i)
-    x[i] << g->mesh_.positions[i], g->topology_.inverse_mass[i];
-  g->collider_.setEllipsoids(rest_ellipsoids.data(), rest_ellipsoids.data(),
-                             static_cast<int>(rest_ellipsoids.size()), params.collision_margin_m);
-  g->collider_.collide(x.data(), nullptr, x.size(), params.xpbd.collision);
-  std::vector<Vec3> start(x.size());
-  for (size_t i = 0; i < x.size(); ++i) start[i] = x[i].head<3>();
+  // Dressing. A garment that starts partly inside the body (an OBJ fitted from another body) is
+  // not pushed out in one go, which would tear it where neighbours leave on different sides:
+  // the body grows from kDressStartScale of its size to full size over the first half of the
+  // dressing time while the cloth is simulated, so collision pushes it out gradually and the
+  // constraints keep it whole. Then it settles on the full-size body.
+  std::vector<Vec3> start(g->mesh_.positions);
   if (!g->solver_->reset(start, err)) return nullptr;
-  const int frames = static_cast<int>(std::ceil(dress_time_s / kSettleFrameS - 1e-4f));
-  for (int f = 0; f < frames; ++f) g->runFrame(rest_ellipsoids, rest_ellipsoids, g->seen_pins_, kSettleFrameS);
+  const int frames = std::max(1, static_cast<int>(std::ceil(dress_time_s / kSettleFrameS - 1e-4f)));
+  const int grow = std::max(1, frames / 2);
+  std::vector<Ellipsoid> from(rest_ellipsoids), to(rest_ellipsoids);
+  auto scaled = [&](float s, std::vector<Ellipsoid>& out) {
+    for (size_t k = 0; k < out.size(); ++k) {
+      out[k] = rest_ellipsoids[k];
+      out[k].radii *= s;
+      out[k].refresh();
+    }
+  };
+  scaled(kDressStartScale, from);
+  GarmentSimParams weightless = params;
+  weightless.xpbd.gravity = Vec3::Zero();
+  if (cut_from_dressed && !g->solver_->setParams(weightless, err)) return nullptr;
+  for (int f = 0; f < frames; ++f) {
+    const float u = std::min(1.0f, static_cast<float>(f + 1) / static_cast<float>(grow));
+    scaled(kDressStartScale + (1.0f - kDressStartScale) * u, to);
+    g->runFrame(from, to, g->seen_pins_, kSettleFrameS);
+    from.swap(to);
+    if (cut_from_dressed && f + 1 == grow) {
+      // Let the cut out to the shape the body gave it, then settle under gravity.
+      std::vector<Vec3> shape(g->particleCount());
+      for (size_t i = 0; i < shape.size(); ++i) shape[i] = g->solver_->x()[i].head<3>();
+      const std::vector<float> flat_shape = flatten(shape);
+      GarmentTopology cut;
+      if (!buildGarmentTopology(flat_shape.data(), shape.size(), g->mesh_.indices.data(), g->mesh_.indices.size(), tp,
+                                cut, err))
+        return nullptr;
+      g->topology_ = std::move(cut);
+      g->mesh_.positions = shape;
+      for (size_t k = 0; k < g->mesh_.pinned.size(); ++k) {
+        const RingPose& r = body_rest.rings()[static_cast<size_t>(g->mesh_.pin_ring[k])];
+        g->mesh_.pin_local[k] = r.frame.transpose() * (shape[g->mesh_.pinned[k]] - r.centre);
+      }
+      g->pinTargets(body_rest, g->seen_pins_);
+      g->solver_ = makeSolver(solver, g->topology_);
+      if (!g->setParams(params, err) || !g->solver_->reset(shape, err)) return nullptr;
+    }
+  }
+  // Whatever is still inside (pinched) goes out now, without the escape limit.
+  {
+    std::vector<Eigen::Vector4f> x(g->solver_->x(), g->solver_->x() + g->particleCount());
+    CollisionParams cp = params.xpbd.collision;
+    cp.max_escape_m = 0.0f;
+    g->collider_.setEllipsoids(rest_ellipsoids.data(), rest_ellipsoids.data(),
+                               static_cast<int>(rest_ellipsoids.size()), params.collision_margin_m);
+    g->collider_.collide(x.data(), nullptr, x.size(), cp);
+    for (size_t i = 0; i < x.size(); ++i) start[i] = x[i].head<3>();
+    if (!g->solver_->reset(start, err)) return nullptr;
+  }
+  const std::vector<Vec3>& x = start;
   g->dressed_.resize(x.size());
   for (size_t i = 0; i < x.size(); ++i) g->dressed_[i] = g->solver_->x()[i].head<3>();
   for (const Vec3& p : g->dressed_) {

@@ -76,13 +76,16 @@ class GarmentSim {
   // built from it: free particles pushed outside, then `dress_time_s` of settling under gravity.
   // Null + err on bad input (mesh, pins, params).
   // ellipsoid_chains: the body chain (Chain) each ellipsoid was built from (ProxySource::chain),
-  // for the collision groups below.
+  // for the collision groups below. cut_from_dressed: the garment's rest shape becomes the shape
+  // it has once pushed outside the ellipsoids (without gravity), as a tailor would let it out: for
+  // meshes made on another body (OBJ garments), which sit tight on that body's skin and would
+  // otherwise be stretched by the ellipsoids' bulges and the collision margin.
   static std::unique_ptr<GarmentSim> create(const GarmentMesh& mesh, const TopologyParams& topo,
                                             ClothSolverKind solver, const GarmentSimParams& params,
                                             float dress_time_s, const BodyModel& body_rest,
                                             const std::vector<Ellipsoid>& rest_ellipsoids,
                                             const std::vector<int>& ellipsoid_chains,
-                                            std::string& err);
+                                            std::string& err, bool cut_from_dressed = false);
   ~GarmentSim();
 
   bool setParams(const GarmentSimParams& params, std::string& err);
