@@ -360,3 +360,61 @@ TEST(CApiGarments, SurvivesATwoMetreTeleport) {
 }
 
 }  // namespace
+
+namespace {
+
+// Inertia scaling: the fraction (1 - inertia) of the pelvis' motion carries the garment directly.
+// A body moving sideways at 1.5 m/s: with inertia 0 a skirt moves exactly with the pelvis; with
+// inertia 1 it is dragged along by its waistband and the legs and its hem lags behind.
+float lagBehindPelvis(float inertia) {
+  ContextPtr ctx = makeContext();
+  drape_cloth_params c;
+  drape_cloth_params_init(&c);
+  c.linear_inertia = inertia;
+  c.angular_inertia = inertia;
+  drape_garment_template t;
+  drape_garment_template_init(&t);
+  t.kind = DRAPE_GARMENT_SKIRT;  // loose: the hem swings behind a moving body
+  t.particles = 600;
+  drape_garment* g = nullptr;
+  EXPECT_EQ(drape_context_add_garment_template(ctx.get(), nullptr, &t, &c, &g), DRAPE_OK) << lastError();
+  auto centroidX = [&]() {
+    const std::vector<float> x = snapshot(g);
+    double sum = 0.0;
+    for (size_t i = 0; i < x.size(); i += 4) sum += x[i];
+    return static_cast<float>(sum / static_cast<double>(x.size() / 4));
+  };
+  // pushAndStep(i) animates a sway; hold the pose of t = 0 instead, first still, then moving.
+  auto held = [&](int i, float dx) {
+    std::vector<drape_joint> j = poseJoints(DRAPE_LAYOUT_KINECT2, 0.0);
+    for (drape_joint& q : j) q.position.x += dx;
+    const drape_skeleton_frame f = makeFrame(DRAPE_LAYOUT_KINECT2, j, i / 30.0);
+    EXPECT_EQ(drape_context_push_skeleton(ctx.get(), &f), DRAPE_OK) << lastError();
+    EXPECT_EQ(drape_context_step(ctx.get(), 1.0f / 30.0f), DRAPE_OK) << lastError();
+  };
+  // The filtered pelvis (the tracker smooths the raw joints) is what the body and garment follow.
+  auto pelvisX = [&]() {
+    drape_vec3 joints[21];
+    EXPECT_EQ(drape_context_read_skeleton(ctx.get(), joints, 21, nullptr), DRAPE_OK) << lastError();
+    return joints[0].x;
+  };
+  int i = 0;
+  for (; i < 30; ++i) held(i, 0.0f);
+  const float before = centroidX(), pelvis_before = pelvisX();
+  float dx = 0.0f;
+  for (int k = 0; k < 10; ++k, ++i) {
+    dx += 1.5f / 30.0f;
+    held(i, dx);
+  }
+  return (pelvisX() - pelvis_before) - (centroidX() - before);
+}
+
+TEST(CApiGarments, InertiaScalingCarriesTheGarmentWithThePelvis) {
+  const float carried = lagBehindPelvis(0.0f), physical = lagBehindPelvis(1.0f), half = lagBehindPelvis(0.5f);
+  EXPECT_NEAR(carried, 0.0f, 0.001f) << "inertia 0: the garment moves exactly with the pelvis";
+  EXPECT_GT(physical, carried + 0.005f) << "inertia 1: the garment lags behind";
+  EXPECT_GT(physical, half);
+  EXPECT_GT(half, carried);
+}
+
+}  // namespace

@@ -386,13 +386,28 @@ void GarmentSim::step(const BodyModel& body, const std::vector<Ellipsoid>& start
     runFrame(end, end, pins_, dt);
   } else {
     // Inertia scaling: the part of the pelvis' rigid motion the garment does not feel moves it.
+    // The body's start-of-step ellipsoids are carried by the same transform, so garment and body
+    // start the step together and only the rest of the motion happens across the substeps
+    // (carrying the garment alone would push the trailing side of it into the body).
     const float fl = 1.0f - params_.linear_inertia, fa = 1.0f - params_.angular_inertia;
     if (fl > 0.0f || fa > 0.0f) {
       const Mat3 R = partialRotation(pr.frame * seen_pelvis_f_.transpose(), fa);
-      carry(R, seen_pelvis_c_, fl * (pr.centre - seen_pelvis_c_), 1.0f);
+      const Vec3 t = fl * (pr.centre - seen_pelvis_c_);
+      carry(R, seen_pelvis_c_, t, 1.0f);
+      carried_start_.resize(start.size());
+      for (size_t k = 0; k < start.size(); ++k) {
+        Ellipsoid e = start[k];
+        e.centre = R * (e.centre - seen_pelvis_c_) + seen_pelvis_c_ + t;
+        e.rotation = R * e.rotation;
+        e.refresh();
+        carried_start_[k] = e;
+      }
+      pinTargets(body, pins_);
+      runFrame(carried_start_, end, pins_, dt);
+    } else {
+      pinTargets(body, pins_);
+      runFrame(start, end, pins_, dt);
     }
-    pinTargets(body, pins_);
-    runFrame(start, end, pins_, dt);
   }
   // NaN guard (cannot happen with validated input; if it does, never hand NaN to the host).
   const Eigen::Vector4f* x = solver_->x();

@@ -159,6 +159,7 @@ class GarmentSim {
 
   // Per-step scratch (sized once).
   std::vector<Vec3> pins_, scratch3_;
+  std::vector<Ellipsoid> carried_start_;
   GarmentStepStats last_;
   uint64_t steps_ = 0;
 };
