@@ -26,10 +26,10 @@ const Take kTakes[] = {
     {"kinect_v2_msft_labanotation/Ges02_balancinghands.csv", 0.3f},
     {"kinect_v2_msft_labanotation/Ges04_comehere.csv", 0.45f},
     {"kinect_v2_msft_labanotation/KinectReader_joints_closerange.csv", 0.95f},
-    {"cmu_mocap_bvh/131_01.bvh", 0.92f},
-    {"cmu_mocap_bvh/131_03.bvh", 0.8f},
-    {"cmu_mocap_bvh/scaled_131_01.bvh", 0.85f},
-    {"cmu_mocap_bvh/scaled_131_03.bvh", 0.8f},
+    {"cmu_mocap_bvh/131_01.bvh", 0.95f},
+    {"cmu_mocap_bvh/131_03.bvh", 0.95f},
+    {"cmu_mocap_bvh/scaled_131_01.bvh", 0.95f},
+    {"cmu_mocap_bvh/scaled_131_03.bvh", 0.95f},
 };
 
 class GarmentOnRecording : public ::testing::TestWithParam<Take> {};
