@@ -23,7 +23,7 @@ struct Take {
 
 const Take kTakes[] = {
     {"kinect_v2_msft_labanotation/Ges01_wavehand.csv", 1.0f},
-    {"kinect_v2_msft_labanotation/Ges02_balancinghands.csv", 0.3f},
+    {"kinect_v2_msft_labanotation/Ges02_balancinghands.csv", 0.4f},
     {"kinect_v2_msft_labanotation/Ges04_comehere.csv", 0.45f},
     {"kinect_v2_msft_labanotation/KinectReader_joints_closerange.csv", 0.95f},
     {"cmu_mocap_bvh/131_01.bvh", 0.95f},

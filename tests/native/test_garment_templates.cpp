@@ -68,6 +68,9 @@ class GarmentTemplate : public testing::TestWithParam<Case> {
     GarmentTemplateParams p;
     p.kind = GetParam().kind;
     p.target_particles = GetParam().target;
+    // The geometry bounds below were measured with the 1.5 cm ease of the first templates; the
+    // default is 2.5 cm now (docs/garments.md), which lets a dress sag a little more unattached.
+    p.ease_m = 0.015f;
     std::string err;
     ok_ = makeGarmentTemplate(body_->model, p, mesh_, err);
     ASSERT_TRUE(ok_) << err;

@@ -392,7 +392,7 @@ typedef struct drape_garment_template {
   uint32_t struct_size;  /* sizeof(drape_garment_template), set by drape_garment_template_init */
   int32_t kind;          /* drape_garment_kind; default DRAPE_GARMENT_TSHIRT */
   uint32_t particles;    /* target particle count, [200, 200000] (result within 15 %); 2000 */
-  float ease_m;          /* clearance over the body, [0.002, 0.1]; 0.015 */
+  float ease_m;          /* clearance over the body, [0.002, 0.1]; 0.025 */
   float length_scale;    /* hem / sleeve / leg lengths, [0.5, 1.5]; 1 */
   uint32_t reserved;     /* must be 0 */
 } drape_garment_template;
@@ -414,7 +414,7 @@ typedef struct drape_cloth_params {
   float shear_compliance;      /* [0, 1]; 1e-6 */
   float bend_compliance;       /* [0, 1]; 1e-3 */
   float tether_compliance;     /* [0, 1]; 0 */
-  float tether_scale;          /* a particle stays within rest * scale of its anchor, [1, 10]; 1 */
+  float tether_scale;          /* a particle stays within rest * scale of its anchor, [1, 10]; 1.1 */
   float static_friction;       /* [0, 10]; 0.6 */
   float kinetic_friction;      /* [0, 10]; 0.4 */
   float collision_margin_m;    /* gap kept outside the ellipsoids (cloth thickness), [0, 0.05]; 0.004 */

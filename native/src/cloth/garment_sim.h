@@ -35,7 +35,13 @@ enum class ClothSolverKind : int { Xpbd = 0, MassSpring = 1 };
 struct GarmentSimParams {
   // Garments limit the collider's escape step to 1 cm: cloth pinched between touching body parts
   // stays pinched instead of being pulled through one of them (proxies/collision.h).
-  GarmentSimParams() { xpbd.collision.max_escape_m = 0.01f; }
+  // Tethers get 10 % slack: a garment moving round the body (a sleeve on a raised arm) moves
+  // particles farther from the collar than they are at rest without stretching any edge, and a
+  // hard limit at the rest distance then fights the stretch constraints (docs/garments.md).
+  GarmentSimParams() {
+    xpbd.collision.max_escape_m = 0.01f;
+    xpbd.tether_scale = 1.1f;
+  }
 
   float substep_hz = 300.0f;    // substeps per simulated second, [30, 20000]
   int max_substeps = 200;       // per step, [1, 1000]; a longer step gets bigger substeps

@@ -20,7 +20,7 @@ enum class GarmentKind : int { TShirt = 0, LongSleeve = 1, Skirt = 2, Dress = 3,
 struct GarmentTemplateParams {
   GarmentKind kind = GarmentKind::TShirt;
   int target_particles = 2000;  // [200, 200000]; the result is within +-15 % (normally +-5 %)
-  float ease_m = 0.015f;        // clearance over the body, [0.002, 0.1] m
+  float ease_m = 0.025f;        // clearance over the body, [0.002, 0.1] m (see docs/garments.md)
   float length_scale = 1.0f;    // scales hem / sleeve / leg lengths, [0.5, 1.5]
 };
 
