@@ -201,7 +201,6 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
   const RingPose& pr = body_rest.rings()[static_cast<size_t>(g->pelvis_ring_)];
   g->seen_pelvis_c_ = pr.centre;
   g->seen_pelvis_f_ = pr.frame;
-  g->seen_ellipsoids_ = rest_ellipsoids;
   g->pinTargets(body_rest, g->seen_pins_);
 
   // Dressing. A garment that starts partly inside the body (an OBJ fitted from another body) is
@@ -420,8 +419,6 @@ void GarmentSim::step(const BodyModel& body, const std::vector<Ellipsoid>& start
   }
   seen_pelvis_c_ = pr.centre;
   seen_pelvis_f_ = pr.frame;
-  seen_ellipsoids_ = end;  // same size after the first step: no allocation
-  seen_pins_ = pins_;
   ++steps_;
   last_.total_ms = msSince(t0);
 }

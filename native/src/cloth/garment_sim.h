@@ -151,12 +151,11 @@ class GarmentSim {
   EllipsoidCollider collider_;
   std::vector<uint8_t> masks_, groups_;
 
-  // What the garment saw at the end of its last step: pelvis ring pose, ellipsoids and pin targets.
+  // The pelvis ring pose the garment saw at the end of its last step (inertia scaling, teleports).
   int pelvis_ring_ = 0;
   Vec3 seen_pelvis_c_ = Vec3::Zero();
   Mat3 seen_pelvis_f_ = Mat3::Identity();
-  std::vector<Ellipsoid> seen_ellipsoids_;
-  std::vector<Vec3> seen_pins_;
+  std::vector<Vec3> seen_pins_;  // attachment targets on the rest body (dressing)
   bool tracked_ = false;  // false until the first step (the garment still sits on the rest pose)
 
   // The dressed shape on the rest pose, bound to the rest body's rings.
