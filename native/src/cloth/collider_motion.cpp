@@ -48,14 +48,14 @@ void ColliderMotion::clear() {
   count_ = 0;
 }
 
-EllipsoidCollider* ColliderMotion::beginSubstep(int s, int n) {
+EllipsoidCollider* ColliderMotion::beginSpan(int s0, int s1, int n) {
   if (!active()) return nullptr;
   if (identical_) {
-    if (s == 0) collider_->setEllipsoids(end_.data(), end_.data(), count_, margin_);
+    if (s0 == 0) collider_->setEllipsoids(end_.data(), end_.data(), count_, margin_);
     return collider_;
   }
-  const float t1 = s + 1 == n ? 1.0f : static_cast<float>(s + 1) / static_cast<float>(n);
-  if (s == 0) {
+  const float t1 = s1 >= n ? 1.0f : static_cast<float>(s1) / static_cast<float>(n);
+  if (s0 == 0) {
     a_ = start_;  // same size: no allocation
   } else {
     a_.swap(b_);  // the previous substep's end is this one's start

@@ -26,7 +26,10 @@ class ColliderMotion {
   bool active() const { return collider_ != nullptr && count_ > 0; }
   // Gives the collider the ellipsoids of substep s of n (interpolated at s/n and (s+1)/n). The
   // substep-end ellipsoids are kept and reused as the next substep's start.
-  EllipsoidCollider* beginSubstep(int s, int n);
+  EllipsoidCollider* beginSubstep(int s, int n) { return beginSpan(s, s + 1, n); }
+  // The same for the span of substeps [s0, s1) (collision every few substeps). Spans must be
+  // consecutive within a step, the first starting at 0.
+  EllipsoidCollider* beginSpan(int s0, int s1, int n);
 
  private:
   EllipsoidCollider* collider_ = nullptr;

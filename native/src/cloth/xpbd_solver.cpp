@@ -284,6 +284,10 @@ bool XpbdSolver::setParams(const XpbdParams& p, std::string& error) {
     error = "max_speed must be finite (<= 0 disables the clamp)";
     return false;
   }
+  if (p.collision_stride < 1 || p.collision_stride > 8) {
+    error = "collision_stride must be in [1, 8]";
+    return false;
+  }
   params_ = p;
   refreshCompliance();
   return true;
@@ -333,11 +337,20 @@ bool XpbdSolver::step(float dt, int substeps) {
   timings_ = XpbdTimings{};
   const float h = dt / static_cast<float>(substeps);
   const float inv_n = 1.0f / static_cast<float>(substeps);
+  const int stride = params_.collision_stride;
+  int span0 = 0;
   for (int s = 0; s < substeps; ++s) {
-    const Clock::time_point t0 = timing_ ? Clock::now() : Clock::time_point{};
-    const EllipsoidCollider* collider = motion_.active() ? motion_.beginSubstep(s, substeps) : collider_;
-    if (timing_) timings_.collision_ns += nsBetween(t0, Clock::now());
-    substep(h, s + 1 == substeps ? 1.0f : static_cast<float>(s + 1) * inv_n, collider);
+    const bool collide = (s + 1 - span0) >= stride || s + 1 == substeps;
+    if (stride > 1 && s == span0) span_start_.assign(x_.begin(), x_.end());  // same size: no allocation
+    const EllipsoidCollider* collider = nullptr;
+    if (collide) {
+      const Clock::time_point t0 = timing_ ? Clock::now() : Clock::time_point{};
+      collider = motion_.active() ? motion_.beginSpan(span0, s + 1, substeps) : collider_;
+      if (timing_) timings_.collision_ns += nsBetween(t0, Clock::now());
+    }
+    substep(h, s + 1 == substeps ? 1.0f : static_cast<float>(s + 1) * inv_n, collider,
+            stride > 1 ? span_start_.data() : nullptr);
+    if (collide) span0 = s + 1;
   }
   return true;
 }
@@ -352,7 +365,8 @@ void XpbdSolver::transform(const Mat3& R, const Vec3& pivot, const Vec3& t, floa
   for (Vec3& p : pin_target_) p = R * (p - pivot) + shift;
 }
 
-void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider) {
+void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider,
+                         const Eigen::Vector4f* span_prev) {
   const Clock::time_point start = timing_ ? Clock::now() : Clock::time_point{};
   const double collision_before = timings_.collision_ns;
   const XpbdParams& p = params_;
@@ -404,7 +418,7 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
   // 3. Collision against the tracking ellipsoids.
   if (collider != nullptr) {
     const Clock::time_point t0 = timing_ ? Clock::now() : Clock::time_point{};
-    const CollisionStats cs = collider->collide(x, prev, n, p.collision);
+    const CollisionStats cs = collider->collide(x, span_prev ? span_prev : prev, n, p.collision);
     collision_stats_.tests += cs.tests;
     collision_stats_.contacts += cs.contacts;
     collision_stats_.swept_catches += cs.swept_catches;
@@ -412,8 +426,17 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
     if (timing_) timings_.collision_ns += nsBetween(t0, Clock::now());
   }
   // 4. Velocities from positions, then damping (w lane: w - w = 0).
+  // The speed clamp applies here too: a collision or constraint correction (a particle squeezed
+  // out between two limbs) must not turn into a velocity that flings it on the next substep.
   const float scale = std::exp(-p.damping * h) / h;
-  for (size_t i = 0; i < n; ++i) vel[i] = (x[i] - prev[i]) * scale;
+  for (size_t i = 0; i < n; ++i) {
+    Vec4 v = (x[i] - prev[i]) * scale;
+    if (max_speed2 > 0.0f) {
+      const float s2 = v.squaredNorm();
+      if (s2 > max_speed2) v *= p.max_speed / std::sqrt(s2);
+    }
+    vel[i] = v;
+  }
   if (timing_) {
     const double collided = timings_.collision_ns - collision_before;
     timings_.constraints_ns += nsBetween(start, Clock::now()) - collided;

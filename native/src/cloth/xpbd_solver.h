@@ -34,6 +34,9 @@ struct XpbdParams {
   Vec3 wind = Vec3::Zero();       // m/s
   float max_speed = 20.0f;        // m/s, speed clamp after integration; <= 0: none
   CollisionParams collision;      // used when a collider is set
+  // Collision every this many substeps (and always on the last), [1, 8]: the swept test and
+  // friction then span the substeps in between. 1 = every substep.
+  int collision_stride = 1;
 };
 
 // Wall-clock split of the last step (only measured when enabled, for benchmarks): constraints =
@@ -98,7 +101,8 @@ class XpbdSolver {
 
  private:
   // pin_t: fraction of the step at the substep end; collider: this substep's, or null.
-  void substep(float h, float pin_t, const EllipsoidCollider* collider);
+  // span_prev: positions at the start of the collision span (the substep start when stride 1).
+  void substep(float h, float pin_t, const EllipsoidCollider* collider, const Eigen::Vector4f* span_prev);
   // Constraint storage for the SIMD kernels: every colour group padded to a multiple of kLanes
   // with dummy constraints on the dummy particle x_[n] (w = 0, never read back), so a batch of
   // kLanes constraints shares no particle and needs no tail loop. Stretch, shear and bend are
@@ -119,6 +123,7 @@ class XpbdSolver {
   float inv_w_h2_ = -1.0f;  // the 1/h^2 that Batches::inv_w was computed for
   std::vector<uint8_t> distance_kind_;  // 0 stretch, 1 shear, 2 bend (3 padding), per entry
   std::vector<Eigen::Vector4f> x_, prev_, v_;  // n + 1 entries: x_[n] is the dummy particle
+  std::vector<Eigen::Vector4f> span_start_;     // positions where the current collision span began
   std::vector<Vec3> pin_start_, pin_target_;
   const EllipsoidCollider* collider_ = nullptr;
   ColliderMotion motion_;
