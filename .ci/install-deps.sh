@@ -4,10 +4,14 @@
 #   --runtime-only: just what building and running the samples needs (no test frameworks).
 set -euo pipefail
 
-packages=(cmake g++ make libeigen3-dev ocl-icd-opencl-dev opencl-headers pocl-opencl-icd)
+# libstb-dev (stb_image_write) and libgif-dev (giflib): drape-replay's PNG pictures and animated GIF.
+packages=(cmake g++ make libeigen3-dev ocl-icd-opencl-dev opencl-headers pocl-opencl-icd libstb-dev libgif-dev)
 if [[ "${1:-}" != "--runtime-only" ]]; then
-  packages+=(googletest libgtest-dev libbenchmark-dev)
+  # clang-15 brings libFuzzer (libclang-common-15-dev) for the fuzz targets tests/run.sh runs.
+  packages+=(googletest libgtest-dev libbenchmark-dev clang-15)
 fi
+
+[[ "${1:-}" == "--runtime-only" ]] || packages+=(mono-complete)  # C# tests under Mono (docs/csharp.md)
 
 missing=()
 for p in "${packages[@]}"; do

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The main job: install what is missing, build Drape, replay the bundled real Kinect v2 recording
 # on the default body, dressed in the default T-shirt (2 000 particles, XPBD), and write body and
-# garment OBJ frames + stats into ./drape-out (or the folder given with --out).
+# garment OBJ frames, pictures (render_NNNNN.png every 5th frame, contact_sheet.png, replay.gif, and
+# replay.mp4 when ffmpeg is on PATH) + stats into ./drape-out (or the folder given with --out).
 # Extra arguments go to drape-replay (see `drape-replay --help`), e.g. --garment dress.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

@@ -3,11 +3,16 @@
 #   cmake -DEXE=... -DOUT_DIR=... -DARGS="a|b|c" -DEXPECT_FRAMES=N -DEXPECT_OBJ=N
 #         [-DEXPECT_GARMENT=template|obj|none -DEXPECT_GARMENT_OBJ=N -DEXPECT_MEASURED=N]
 #         [-DEXPECT_FORMAT=kinect_csv] [-DVOLUME_MIN_L=x -DVOLUME_MAX_L=y] [-DPYTHON=python3]
+#         [-DEXPECT_RENDERED=N -DEXPECT_PNG_SIZE=WxH -DEXPECT_SHEET=ON|OFF -DEXPECT_GIF=ON|OFF]
 #         -P check_stats.cmake
 # EXPECT_GARMENT (default template) is garment.source. With a garment it requires particles > 0,
 # every garment number finite (a JSON number, not null) and one step per updated frame; with
 # none, particles = 0 and the cloth keys null. No physics quality bounds (stretch, penetration):
 # those belong to the cloth tests and benchmarks.
+# EXPECT_RENDERED is render.frames_rendered and the number of render_*.png files; with N > 0 the
+# first one must be a PNG (signature, IHDR) of EXPECT_PNG_SIZE pixels. EXPECT_SHEET=ON requires
+# contact_sheet.png, a valid PNG named by render.contact_sheet; EXPECT_GIF=ON requires replay.gif
+# starting "GIF89a" and named by render.gif; OFF requires the key null.
 # The program is run with --out OUT_DIR (emptied first) plus ARGS; stats are read from
 # OUT_DIR/stats.json with string(JSON), so no Python is needed (PYTHON, when given, also runs
 # `python3 -m json.tool` on the file).
@@ -73,7 +78,9 @@ foreach(path "drape_version" "recording" "format" "layout" "frames" "rejected_fr
              "garment|edges" "garment|attached" "garment|frames_stepped" "garment|max_stretch"
              "garment|p99_stretch" "garment|proxy_inside" "garment|body_penetration_mm|p99"
              "garment|body_penetration_mm|max" "garment|deeper_than_2mm" "garment|frames_measured"
-             "garment|teleport_resets" "garment|nan_resets" "garment|contacts" "garment|substeps")
+             "garment|teleport_resets" "garment|nan_resets" "garment|contacts" "garment|substeps"
+             "render|frames_rendered" "render|every" "render|camera" "render|width" "render|height"
+             "render|contact_sheet" "render|gif" "render|mp4" "render|ms_per_frame_median")
   string(REPLACE "|" ";" _keys "${path}")
   json_get(_unused ${_keys})
 endforeach()
@@ -215,6 +222,77 @@ if(DEFINED EXPECT_GARMENT_OBJ)
     expect_equal("v lines in ${_first}" "${_nv}" "${_particles}")
     expect_equal("vn lines in ${_first}" "${_nvn}" "${_particles}")
     expect_equal("f lines in ${_first}" "${_nf}" "${_gtriangles}")
+  endif()
+endif()
+
+# Pictures.
+# Reads a PNG's signature and IHDR size into <out_w> <out_h> (empty when it is not a PNG).
+function(png_size path out_w out_h)
+  set(${out_w} "" PARENT_SCOPE)
+  set(${out_h} "" PARENT_SCOPE)
+  if(NOT EXISTS "${path}")
+    return()
+  endif()
+  file(READ "${path}" _hex LIMIT 24 HEX)
+  # 8-byte signature, then the IHDR chunk: length 13, "IHDR", width, height (big-endian).
+  string(LENGTH "${_hex}" _len)
+  if(NOT _len EQUAL 48 OR NOT _hex MATCHES "^89504e470d0a1a0a0000000d49484452")
+    return()
+  endif()
+  string(SUBSTRING "${_hex}" 32 8 _w_hex)
+  string(SUBSTRING "${_hex}" 40 8 _h_hex)
+  math(EXPR _w "0x${_w_hex}")
+  math(EXPR _h "0x${_h_hex}")
+  set(${out_w} "${_w}" PARENT_SCOPE)
+  set(${out_h} "${_h}" PARENT_SCOPE)
+endfunction()
+expect_type(NUMBER render frames_rendered)
+if(DEFINED EXPECT_RENDERED)
+  json_get(_rendered render frames_rendered)
+  expect_equal("render.frames_rendered" "${_rendered}" "${EXPECT_RENDERED}")
+  file(GLOB _pngs "${OUT_DIR}/render_*.png")
+  list(LENGTH _pngs _png_count)
+  expect_equal("render_*.png files" "${_png_count}" "${EXPECT_RENDERED}")
+  if(_png_count GREATER 0)
+    list(SORT _pngs)
+    list(GET _pngs 0 _first_png)
+    png_size("${_first_png}" _pw _ph)
+    if(_pw STREQUAL "")
+      string(APPEND _failures "  ${_first_png} is not a PNG (signature + IHDR)\n")
+    elseif(DEFINED EXPECT_PNG_SIZE AND NOT "${_pw}x${_ph}" STREQUAL EXPECT_PNG_SIZE)
+      string(APPEND _failures "  ${_first_png} is ${_pw}x${_ph}, expected ${EXPECT_PNG_SIZE}\n")
+    endif()
+  endif()
+endif()
+if(DEFINED EXPECT_SHEET)
+  if(EXPECT_SHEET)
+    json_get(_sheet render contact_sheet)
+    png_size("${OUT_DIR}/contact_sheet.png" _sw _sh)
+    if(_sw STREQUAL "" OR NOT _sw GREATER 0 OR NOT _sh GREATER 0)
+      string(APPEND _failures "  ${OUT_DIR}/contact_sheet.png is missing or not a PNG\n")
+    endif()
+    if(NOT _sheet MATCHES "contact_sheet\\.png$")
+      string(APPEND _failures "  render.contact_sheet = '${_sheet}', expected the contact_sheet.png path\n")
+    endif()
+  else()
+    expect_type(NULL render contact_sheet)
+  endif()
+endif()
+if(DEFINED EXPECT_GIF)
+  if(EXPECT_GIF)
+    json_get(_gif render gif)
+    set(_gif_header "")
+    if(EXISTS "${OUT_DIR}/replay.gif")
+      file(READ "${OUT_DIR}/replay.gif" _gif_header LIMIT 6 HEX)
+    endif()
+    if(NOT _gif_header STREQUAL "474946383961")  # "GIF89a"
+      string(APPEND _failures "  ${OUT_DIR}/replay.gif is missing or does not start with GIF89a\n")
+    endif()
+    if(NOT _gif MATCHES "replay\\.gif$")
+      string(APPEND _failures "  render.gif = '${_gif}', expected the replay.gif path\n")
+    endif()
+  else()
+    expect_type(NULL render gif)
   endif()
 endif()
 

@@ -8,6 +8,8 @@
 #include "mesh_checks.h"
 #include "obj_writer.h"
 #include "options.h"
+#include "pictures.h"
+#include "progress.h"
 #include "stats.h"
 
 #include <algorithm>
@@ -218,11 +220,12 @@ int run(int argc, char** argv) {
 
   // Outputs: create directories before spending time on the replay.
   const std::string stats_path = replay::resolveStatsPath(opt);
-  if (opt.write_obj && !ensureDirectory(opt.out_dir, error)) return fail(kExitUsage, error);
+  const uint32_t frames = opt.max_frames == 0 ? info.frame_count : std::min(opt.max_frames, info.frame_count);
+  const bool render_due = replay::resolveRenderEvery(opt, frames) != 0;
+  if ((opt.write_obj || render_due) && !ensureDirectory(opt.out_dir, error)) return fail(kExitUsage, error);
   if (!stats_path.empty() && !ensureDirectory(fs::path(stats_path).parent_path(), error))
     return fail(kExitUsage, error);
 
-  const uint32_t frames = opt.max_frames == 0 ? info.frame_count : std::min(opt.max_frames, info.frame_count);
   std::vector<drape_joint> joints(info.joint_count);
   std::vector<drape_vec3> positions(vertex_count), normals(vertex_count);
   // The topology is fixed for a context (drape.h): read and check it once, not every frame.
@@ -239,7 +242,7 @@ int run(int argc, char** argv) {
     if (drape_result r = drape_garment_get_mesh_size(garment, &garment_vertices, &garment_index_count))
       return fail(kExitFailure, "drape_garment_get_mesh_size failed: " + libraryReason(r));
     garment_positions.resize(garment_vertices);
-    if (opt.write_obj) garment_normals.resize(garment_vertices);
+    if (opt.write_obj || render_due) garment_normals.resize(garment_vertices);
     garment_indices.resize(garment_index_count);
     if (drape_result r = drape_garment_read_mesh(garment, nullptr, nullptr, 0, garment_indices.data(),
                                                  garment_index_count))
@@ -285,8 +288,29 @@ int run(int argc, char** argv) {
   st.volume_l.reserve(frames);
   constexpr uint32_t kMaxRejectionMessages = 5;
 
+  // Pictures (drawn outside the timed calls) and the progress bar (a terminal only).
+  replay::Pictures pictures;
+  pictures.begin(opt, frames, info.nominal_rate_hz, fs::path(path).filename().string(),
+                 garment ? (st.garment_from_obj ? fs::path(opt.garment_obj).filename().string() : st.garment_kind)
+                         : std::string("NO GARMENT"),
+                 st.render);
+  if (render_due && !st.render.png_available && !opt.quiet)
+    std::fprintf(stderr, "drape-replay: note: built without stb_image_write, so no pictures; install libstb-dev "
+                         "(bash .ci/install-deps.sh) and rebuild\n");
+  replay::ProgressBar progress(frames, !opt.quiet && replay::stderrIsTerminal());
+  double frame_timestamp = 0.0;
+  auto renderFrame = [&](uint32_t index) {
+    if (!pictures.active()) return true;
+    static const std::vector<drape_vec3> kNoVertices;
+    static const std::vector<uint32_t> kNoIndices;
+    return pictures.addFrame(index, frame_timestamp, positions, normals, indices,
+                             garment ? garment_positions : kNoVertices, garment ? garment_normals : kNoVertices,
+                             garment ? garment_indices : kNoIndices, st.render, error);
+  };
+
   using Clock = std::chrono::steady_clock;
   for (uint32_t i = 0; i < frames; ++i) {
+    progress.update(i);
     double timestamp = 0.0;
     if (drape_result r = drape_recording_read_frame(rec.get(), i, joints.data(),
                                                     static_cast<uint32_t>(joints.size()), &timestamp))
@@ -306,6 +330,7 @@ int run(int argc, char** argv) {
       if (isFatalLibraryError(r))
         return fail(kExitFailure, "drape_context_push_skeleton failed on frame " + std::to_string(i) + ": " +
                                       libraryReason(r));
+      if (!opt.quiet && st.rejected_frames < kMaxRejectionMessages) progress.finish();
       if (!opt.quiet && st.rejected_frames < kMaxRejectionMessages)
         std::fprintf(stderr, "drape-replay: frame %u rejected: %s%s\n", i, libraryReason(r).c_str(),
                      st.rejected_frames + 1 == kMaxRejectionMessages ? " (further rejections not shown)" : "");
@@ -365,7 +390,11 @@ int run(int argc, char** argv) {
         return fail(kExitFailure, error);
     }
 
-    if (!garment) continue;
+    frame_timestamp = timestamp;
+    if (!garment) {
+      if (!renderFrame(i)) return fail(kExitFailure, error);
+      continue;
+    }
     drape_garment_stats gs{};
     gs.struct_size = sizeof gs;
     if (drape_result r = drape_garment_get_stats(garment, &gs))
@@ -397,7 +426,8 @@ int run(int argc, char** argv) {
     }
 
     if (drape_result r = drape_garment_read_mesh(garment, garment_positions.data(),
-                                                 opt.write_obj ? garment_normals.data() : nullptr, garment_vertices,
+                                                 garment_normals.empty() ? nullptr : garment_normals.data(),
+                                                 garment_vertices,
                                                  nullptr, 0))
       return fail(kExitFailure, "drape_garment_read_mesh failed on frame " + std::to_string(i) + ": " +
                                     libraryReason(r));
@@ -412,7 +442,11 @@ int run(int argc, char** argv) {
       if (!replay::writeObj(obj.string(), garment_positions, garment_normals, garment_indices, comment, error))
         return fail(kExitFailure, error);
     }
+    if (!renderFrame(i)) return fail(kExitFailure, error);
   }
+  progress.update(frames);
+  if (!pictures.finish(st.render, error)) return fail(kExitFailure, error);
+  progress.finish();
 
   drape_frame_stats final_stats{};
   final_stats.struct_size = sizeof final_stats;

@@ -2,6 +2,7 @@
 // out-of-range numbers are errors (exit 2), never silently ignored or clamped.
 #include "options.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -256,6 +257,44 @@ bool parseOptions(int argc, const char* const* argv, Options& o, std::string& er
         return false;
       }
       o.measure_given = true;
+    } else if (name == "--no-render") {
+      if (!flag()) return false;
+      o.render = false;
+    } else if (name == "--render-every") {
+      if (!takeValue()) return false;
+      if (!parseUint(value, 0, 0xffffffffUL, o.render_every)) {
+        error = "--render-every '" + value + "' is not a whole number >= 0 (e.g. --render-every 5; 0 = no pictures)";
+        return false;
+      }
+      o.render_every_given = true;
+    } else if (name == "--camera") {
+      if (!takeValue()) return false;
+      if (value != "sensor" && value != "side" && value != "both") {
+        error = "--camera '" + value + "' is not sensor, side or both (e.g. --camera sensor)";
+        return false;
+      }
+      o.camera = value;
+      o.render_options_given = true;
+    } else if (name == "--size") {
+      if (!takeValue()) return false;
+      const size_t x = value.find_first_of("xX");
+      if (x == std::string::npos || !parseUint(value.substr(0, x), 64, 4096, o.width) ||
+          !parseUint(value.substr(x + 1), 64, 4096, o.height)) {
+        error = "--size '" + value + "' is not WIDTHxHEIGHT with each in [64, 4096] pixels (e.g. --size 480x640)";
+        return false;
+      }
+      o.render_options_given = true;
+    } else if (name == "--backend") {
+      if (!takeValue()) return false;
+      if (value == "opencl") {
+        error = "--backend opencl: the OpenCL backend is not built yet; use --backend cpu (the default)";
+        return false;
+      }
+      if (value != "cpu") {
+        error = "--backend '" + value + "' is not a backend; use --backend cpu (the only one in this build)";
+        return false;
+      }
+      o.backend = value;
     } else if (name == "--out") {
       if (!takeValue()) return false;
       if (value.empty()) {
@@ -283,6 +322,11 @@ bool parseOptions(int argc, const char* const* argv, Options& o, std::string& er
             " has no effect with --garment none; drop it or choose a garment";
     return false;
   }
+  if (!o.render && (o.render_every_given || o.render_options_given)) {
+    error = std::string(o.render_every_given ? "--render-every" : o.camera != "both" ? "--camera" : "--size") +
+            " has no effect with --no-render; drop one of them";
+    return false;
+  }
   if (!o.garment_obj.empty() && o.particles != 0) {
     error = "--particles sets a template garment's resolution; an OBJ garment keeps its own vertices, "
             "so drop --particles or use --garment tshirt|longsleeve|skirt|dress|trousers";
@@ -299,6 +343,13 @@ const char* garmentKindName(int32_t kind) {
 
 const char* solverName(int32_t solver) {
   return solver == DRAPE_SOLVER_MASS_SPRING ? "massspring" : "xpbd";
+}
+
+uint32_t resolveRenderEvery(const Options& o, uint32_t frames) {
+  if (!o.render) return 0;
+  if (o.render_every_given) return o.render_every;
+  if (!o.write_obj && !o.out_given) return 0;
+  return std::max<uint32_t>(1, frames / 30);
 }
 
 std::string resolveStatsPath(const Options& o) {
@@ -319,7 +370,8 @@ std::string helpText() {
       "Usage: drape-replay [options]\n"
       "With no options it replays the bundled Kinect v2 recording (Ges01_wavehand.csv) on the\n"
       "default body (1.70 m, 65 kg) in a 2 000-particle T-shirt and writes body_NNNNN.obj,\n"
-      "garment_NNNNN.obj and stats.json into ./drape-out.\n"
+      "garment_NNNNN.obj, pictures (render_NNNNN.png, contact_sheet.png, replay.gif) and\n"
+      "stats.json into ./drape-out. A progress bar shows on a terminal for runs over a second.\n"
       "\n"
       "Options (\"--opt value\" or \"--opt=value\"):\n"
       "  --recording PATH      Kinect v2 CSV, BVH or Drape .drec file (format detected from content)\n"
@@ -346,12 +398,23 @@ std::string helpText() {
       "                        (default ./drape-out; created if missing)\n"
       "  --no-obj              do not write OBJ files (for timing)\n"
       "  --stats FILE.json     stats file (default DIR/stats.json; with --no-obj and no --out: none)\n"
-      "  --quiet, -q           no summary on stdout\n"
+      "  --render-every N      draw a picture every N frames: DIR/render_NNNNN.png, plus\n"
+      "                        contact_sheet.png (12 frames across the take) and replay.gif\n"
+      "                        (and replay.mp4 when ffmpeg is on PATH). Default: about 30 per\n"
+      "                        take (frames / 30); 0 = none\n"
+      "  --camera C            sensor (the sensor's view, mirrored like a mirror), side (from the\n"
+      "                        person's right) or both side by side (default)\n"
+      "  --size WxH            size of one view in pixels, each in [64, 4096] (default 480x640)\n"
+      "  --no-render           no pictures at all (same as --render-every 0)\n"
+      "  --backend B           cloth backend: cpu (the default and the only one in this build)\n"
+      "  --quiet, -q           no summary on stdout, no progress bar\n"
       "  --help, -h            this text\n"
       "\n"
       "Examples:\n"
       "  drape-replay\n"
       "  drape-replay --recording take.csv --frames 100 --out /tmp/take\n"
+      "  drape-replay --camera sensor --size 720x960 --render-every 1 --no-obj --out /tmp/pics\n"
+      "  drape-replay --no-render --no-obj --stats timing.json\n"
       "  drape-replay --body sex=female,height_m=1.62,weight_kg=58,waist_mm=720 --no-obj --stats s.json\n"
       "  drape-replay --recording scaled_131_03.bvh --ring-points 32 --no-obj --quiet --stats bvh.json\n"
       "  drape-replay --garment dress --particles 8000 --no-obj --stats dress.json\n"

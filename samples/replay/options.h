@@ -36,6 +36,15 @@ struct Options {
   std::string stats_path;          // empty: see resolveStatsPath
   bool quiet = false;
   bool help = false;
+
+  // Pictures (render.h): frames every N updated frames (0 = none), the views, the size of one view.
+  bool render = true;              // --no-render: false
+  uint32_t render_every = 0;       // only when render_every_given; else about 30 frames per take
+  bool render_every_given = false;
+  std::string camera = "both";     // sensor | side | both
+  uint32_t width = 480, height = 640;
+  bool render_options_given = false;  // --camera or --size
+  std::string backend = "cpu";     // the only backend in this build
 };
 
 // Parses argv. On a bad argument returns false and sets `error` to a one-line message saying what
@@ -45,6 +54,11 @@ bool parseOptions(int argc, const char* const* argv, Options& out, std::string& 
 // Where the stats JSON goes: --stats if given, else DIR/stats.json when OBJs are written or --out
 // was given, else nowhere (empty string).
 std::string resolveStatsPath(const Options& options);
+
+// How often frames are rendered for a replay of `frames` frames: 0 (none) with --no-render or
+// --render-every 0, or with --no-obj and no --out unless --render-every was given (a timing run
+// writes no files); --render-every N as given; else max(1, frames / 30), about 30 pictures a take.
+uint32_t resolveRenderEvery(const Options& options, uint32_t frames);
 
 // The name of a garment template kind as --garment spells it ("tshirt", "longsleeve", ...).
 const char* garmentKindName(int32_t kind);

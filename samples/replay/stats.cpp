@@ -192,6 +192,23 @@ std::string statsJson(const ReplayStats& s) {
   w.key("substeps").value(median(s.substeps));
   w.endObject();
 
+  const RenderStats& r = s.render;
+  auto pathOrNull = [&](const char* key, const std::string& path) {
+    if (path.empty()) w.key(key).null();
+    else w.key(key).value(path);
+  };
+  w.key("render").beginObject();
+  w.key("frames_rendered").value(r.frames_rendered);
+  w.key("every").value(r.every);
+  w.key("camera").value(r.camera);
+  w.key("width").value(r.width);
+  w.key("height").value(r.height);
+  pathOrNull("contact_sheet", r.contact_sheet);
+  pathOrNull("gif", r.gif);
+  pathOrNull("mp4", r.mp4);
+  w.key("ms_per_frame_median").value(median(r.ms));
+  w.endObject();
+
   w.endObject();
   return w.str();
 }
@@ -253,6 +270,21 @@ std::string summaryText(const ReplayStats& s, const std::string& obj_dir, const 
   o += "\n";
   if (!obj_dir.empty())
     o += "obj         " + obj_dir + "/body_NNNNN.obj" + (s.has_garment ? ", garment_NNNNN.obj" : "") + "\n";
+  const RenderStats& r = s.render;
+  if (!r.png_available && r.every != 0) {
+    o += "pictures    none: this drape-replay was built without stb_image_write (install libstb-dev,\n"
+         "            e.g. bash .ci/install-deps.sh, then rebuild)\n";
+  } else if (r.every == 0) {
+    o += "pictures    off (--no-render, --render-every 0, or --no-obj without --out)\n";
+  } else {
+    const std::string views = r.camera == "both" ? "sensor + side views" : r.camera + " view";
+    appendf(o, "pictures    %u frames (every %u), %s, %ux%u each: %s/render_NNNNN.png\n", r.frames_rendered, r.every,
+        views.c_str(), r.width, r.height, r.dir.c_str());
+    if (!r.contact_sheet.empty()) o += "            contact sheet " + r.contact_sheet + "\n";
+    o += "            animation " + (r.gif.empty() ? std::string("none (built without giflib: install libgif-dev)") : r.gif) +
+         (r.mp4.empty() ? "; no MP4 (" + r.mp4_note + ")" : ", " + r.mp4) + "\n";
+    appendf(o, "            %.1f ms per picture (median; software rasteriser, outside the timed calls)\n", median(r.ms));
+  }
   if (!stats_path.empty()) o += "stats       " + stats_path + "\n";
   return o;
 }

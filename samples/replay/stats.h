@@ -12,6 +12,19 @@
 
 namespace replay {
 
+// The pictures (--render-every, --camera, --size; pictures.h).
+struct RenderStats {
+  bool png_available = false;      // built with stb_image_write
+  uint32_t every = 0;              // 0: no pictures
+  std::string camera = "both";
+  uint32_t width = 0, height = 0;  // one view
+  std::string dir;                 // where render_NNNNN.png go
+  uint32_t frames_rendered = 0;    // render_NNNNN.png written
+  std::vector<double> ms;          // per rendered picture (rasterise + compose, no file writing)
+  std::string contact_sheet, gif, mp4;  // paths; empty: not written (JSON null)
+  std::string mp4_note;            // why there is no MP4 ("ffmpeg not on PATH", ...)
+};
+
 struct ReplayStats {
   std::string drape_version;
   std::string recording;
@@ -60,6 +73,8 @@ struct ReplayStats {
   // Per measured frame (drape_garment_measure, --measure-every).
   uint64_t proxy_inside = 0;       // summed over measured frames
   std::vector<double> penetration_p99_mm, penetration_max_mm, deeper_than_2mm;
+
+  RenderStats render;
 };
 
 // Median (mean of the two middle values for an even count) and nearest-rank percentile
