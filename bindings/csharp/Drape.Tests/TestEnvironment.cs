@@ -12,7 +12,7 @@ namespace Drape.Tests
     /// <summary>Where the tests find the native library, the repository and the shared data.</summary>
     internal static class TestEnvironment
     {
-        private static string Metadata(string key) =>
+        public static string Metadata(string key) =>
             typeof(TestEnvironment).Assembly.GetCustomAttributes<AssemblyMetadataAttribute>()
                 .FirstOrDefault(a => a.Key == key)?.Value ?? "";
 

@@ -55,7 +55,7 @@ namespace Drape.Tests
         public void ResultNames_AreTheHeadersEnumeratorNames()
         {
             string h = TestEnvironment.HeaderText;
-            foreach (ResultCode code in Enum.GetValues<ResultCode>())
+            foreach (ResultCode code in (ResultCode[])Enum.GetValues(typeof(ResultCode)))
             {
                 string name = DrapeLibrary.ResultName(code);
                 Assert.Matches(@"\b" + name + @"\s*=\s*" + (int)code + @"\b", h);

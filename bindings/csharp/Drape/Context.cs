@@ -1,5 +1,6 @@
 using System;
 using System.Collections.Generic;
+using System.Runtime.InteropServices;
 
 namespace Drape
 {
@@ -121,9 +122,13 @@ namespace Drape
                 throw new ArgumentException(
                     $"orientations has {orientations.Length} entries; it must be empty or have one per joint ({joints.Length})",
                     nameof(orientations));
-            fixed (Joint* pj = joints)
-            fixed (Quaternionf* pq = orientations)
+            // ReadOnlySpan is pinned through MemoryMarshal.GetReference, not `fixed (T* p = span)`:
+            // see Pinning.cs (Mono 6's corlib lacks the signature `fixed` compiles to).
+            fixed (Joint* pj0 = &MemoryMarshal.GetReference(joints))
+            fixed (Quaternionf* pq0 = &MemoryMarshal.GetReference(orientations))
             {
+                Joint* pj = Pinning.OrNull(pj0, joints.Length);
+                Quaternionf* pq = Pinning.OrNull(pq0, orientations.Length);
                 SkeletonFrame frame;
                 frame.StructSize = (uint)sizeof(SkeletonFrame);
                 frame.Layout = layout;
@@ -257,10 +262,13 @@ namespace Drape
             ClothParams c = cloth.GetValueOrDefault();
             IntPtr g;
             byte none = 0;  // an empty span is empty text (a Parse error), not a NULL pointer
-            fixed (byte* p = objText)
+            fixed (byte* p0 = &MemoryMarshal.GetReference(objText))
+            {
+                byte* p = Pinning.OrNull(p0, objText.Length);
                 DrapeException.Check(Native.drape_context_add_garment_obj_memory(
                     h, p != null ? p : &none, (UIntPtr)(uint)objText.Length, fit.HasValue ? &f : null,
                     desc.HasValue ? &d : null, cloth.HasValue ? &c : null, &g));
+            }
             return Adopt(g);
         }
 
@@ -281,12 +289,16 @@ namespace Drape
             IntPtr g;
             Vector3f noVertex;
             uint noIndex;
-            fixed (Vector3f* pp = positions)
-            fixed (uint* pi = indices)
+            fixed (Vector3f* pp0 = &MemoryMarshal.GetReference(positions))
+            fixed (uint* pi0 = &MemoryMarshal.GetReference(indices))
+            {
+                Vector3f* pp = Pinning.OrNull(pp0, positions.Length);
+                uint* pi = Pinning.OrNull(pi0, indices.Length);
                 DrapeException.Check(Native.drape_context_add_garment_mesh(
                     h, pp != null ? pp : &noVertex, (uint)positions.Length, pi != null ? pi : &noIndex,
                     (uint)indices.Length, fit.HasValue ? &f : null, desc.HasValue ? &d : null,
                     cloth.HasValue ? &c : null, &g));
+            }
             return Adopt(g);
         }
 

@@ -1,4 +1,5 @@
 using System;
+using System.Runtime.InteropServices;
 
 namespace Drape
 {
@@ -49,8 +50,9 @@ namespace Drape
         {
             DrapeLibrary.EnsureCompatible();
             IntPtr h;
-            fixed (byte* p = data)
-                DrapeException.Check(Native.drape_recording_open_memory(p, (UIntPtr)(uint)data.Length, (int)layout, &h));
+            fixed (byte* p0 = &MemoryMarshal.GetReference(data))   // not `fixed (p = data)`: see Pinning.cs
+                DrapeException.Check(Native.drape_recording_open_memory(Pinning.OrNull(p0, data.Length),
+                                                                         (UIntPtr)(uint)data.Length, (int)layout, &h));
             return new Recording(h);
         }
 

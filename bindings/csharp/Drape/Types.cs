@@ -489,7 +489,7 @@ namespace Drape
         public GarmentKind Kind;
         /// <summary>particles: target particle count, [200, 200000] (the result is within 15 %); default 2000.</summary>
         public uint Particles;
-        /// <summary>ease_m: clearance over the body, [0.002, 0.1]; default 0.015.</summary>
+        /// <summary>ease_m: clearance over the body, [0.002, 0.1]; default 0.025.</summary>
         public float EaseM;
         /// <summary>length_scale: hem / sleeve / leg lengths, [0.5, 1.5]; default 1.</summary>
         public float LengthScale;
@@ -543,7 +543,7 @@ namespace Drape
         public float BendCompliance;
         /// <summary>tether_compliance: [0, 1]; default 0.</summary>
         public float TetherCompliance;
-        /// <summary>tether_scale: a particle stays within rest * scale of its anchor, [1, 10]; default 1.</summary>
+        /// <summary>tether_scale: a particle stays within rest * scale of its anchor, [1, 10]; default 1.1.</summary>
         public float TetherScale;
         /// <summary>static_friction: [0, 10]; default 0.6.</summary>
         public float StaticFriction;

@@ -1,0 +1,146 @@
+// Drape sample (Unity): dresses the person a joint source sees and updates the garment's Mesh, and
+// optionally the body's, every frame. The joint source is pluggable: any component implementing
+// Drape.IJointSource (RecordingJointSourceBehaviour from the package, KinectV2JointSourceBehaviour
+// below with DRAPE_KINECT_V2 defined, your own), or any IJointSource set from code (JointSource,
+// e.g. an AzureKinectJointSource). docs/unity.md walks through the setup.
+using System;
+using Drape;
+using UnityEngine;
+
+namespace Drape.Samples
+{
+    /// <summary>
+    /// Drives a <see cref="DressingLoop"/> from <c>Update()</c> and writes the garment (and body)
+    /// vertices into Meshes. No managed allocation per frame: the vertex arrays are allocated once in
+    /// OnEnable and the library writes into them directly (<see cref="DrapeUnity.AsDrape"/>).
+    /// Disposes everything in OnDisable (native objects are never left to the garbage collector).
+    /// </summary>
+    [AddComponentMenu("Drape/Drape Dresser")]
+    [DisallowMultipleComponent]
+    public sealed class DrapeDresser : MonoBehaviour
+    {
+        [Header("Input")]
+        [Tooltip("A component implementing Drape.IJointSource. Empty: the first one on this GameObject, unless JointSource was set from code.")]
+        [SerializeField] private MonoBehaviour jointSource = null;
+
+        [Header("Garment")]
+        [SerializeField] private GarmentKind garment = GarmentKind.TShirt;
+        [Tooltip("Cloth particles (0: the template's default, 2 000).")]
+        [SerializeField] private int particles = 0;
+        [Tooltip("Receives the garment mesh (its sharedMesh is replaced).")]
+        [SerializeField] private MeshFilter garmentMesh = null;
+        [Tooltip("Normals from Drape (true) or Mesh.RecalculateNormals (false).")]
+        [SerializeField] private bool drapeNormals = true;
+
+        [Header("Body (optional)")]
+        [Tooltip("Receives the body mesh; leave empty not to read the body.")]
+        [SerializeField] private MeshFilter bodyMesh = null;
+
+        [Header("Space")]
+        [Tooltip("Drape's space is right-handed; X turns it into Unity's left-handed one as seen from the sensor.")]
+        [SerializeField] private AxisFlip axisFlip = AxisFlip.X;
+
+        private IJointSource _sourceFromCode;
+        private DressingLoop _loop;
+        private Garment _garment;
+        private Mesh _garmentMesh, _bodyMesh;
+        private Vector3[] _garmentPositions, _garmentNormals, _bodyPositions, _bodyNormals;
+
+        /// <summary>A joint source set from code (before the component is enabled); it wins over
+        /// the serialized component.</summary>
+        public IJointSource JointSource
+        {
+            get => _sourceFromCode;
+            set => _sourceFromCode = value;
+        }
+
+        /// <summary>The running loop (null while disabled): its Context gives statistics and the body shape.</summary>
+        public DressingLoop Loop => _loop;
+
+        /// <summary>The garment (null while disabled).</summary>
+        public Garment Garment => _garment;
+
+        private IJointSource FindSource()
+        {
+            if (_sourceFromCode != null) return _sourceFromCode;
+            if (jointSource != null)
+            {
+                if (jointSource is IJointSource s) return s;
+                throw new InvalidOperationException($"{jointSource.GetType().Name} does not implement Drape.IJointSource");
+            }
+            IJointSource onThis = GetComponent<IJointSource>();
+            if (onThis != null) return onThis;
+            throw new InvalidOperationException("DrapeDresser needs a joint source: set one in the inspector or JointSource from code");
+        }
+
+        private void OnEnable()
+        {
+            try
+            {
+                _loop = new DressingLoop(FindSource());
+                GarmentTemplate tmpl = GarmentTemplate.CreateDefault(garment);
+                if (particles > 0) tmpl.Particles = (uint)particles;
+                _garment = _loop.Context.AddGarment(tmpl);
+
+                _garmentPositions = new Vector3[_garment.VertexCount];
+                _garmentNormals = new Vector3[_garment.VertexCount];
+                var triangles = new int[_garment.IndexCount];
+                MeshSpace.ReadGarmentTriangles(_garment, triangles, axisFlip);
+                _garmentMesh = DrapeUnity.CreateDynamicMesh("Drape garment", _garmentPositions, triangles);
+                if (garmentMesh != null) garmentMesh.sharedMesh = _garmentMesh;
+
+                if (bodyMesh != null)
+                {
+                    var (vertexCount, indexCount) = _loop.Context.GetBodyMeshSize();
+                    _bodyPositions = new Vector3[vertexCount];
+                    _bodyNormals = new Vector3[vertexCount];
+                    var bodyTriangles = new int[indexCount];
+                    MeshSpace.ReadBodyTriangles(_loop.Context, bodyTriangles, axisFlip);
+                    _bodyMesh = DrapeUnity.CreateDynamicMesh("Drape body", _bodyPositions, bodyTriangles);
+                    bodyMesh.sharedMesh = _bodyMesh;
+                }
+            }
+            catch (Exception e)
+            {
+                Debug.LogError($"DrapeDresser: {e.Message}", this);
+                Release();
+                enabled = false;
+            }
+        }
+
+        private void Update()
+        {
+            if (_loop == null) return;
+            _loop.Tick(Time.deltaTime);
+            if (!_loop.HasBody) return;   // no accepted frame yet
+
+            MeshSpace.ReadGarment(_garment, _garmentPositions.AsDrape(),
+                                  drapeNormals ? _garmentNormals.AsDrape() : Span<Vector3f>.Empty, axisFlip);
+            _garmentMesh.SetVertices(_garmentPositions);
+            if (drapeNormals) _garmentMesh.SetNormals(_garmentNormals);
+            else _garmentMesh.RecalculateNormals();
+            _garmentMesh.RecalculateBounds();
+
+            if (_bodyMesh != null)
+            {
+                MeshSpace.ReadBody(_loop.Context, _bodyPositions.AsDrape(), _bodyNormals.AsDrape(), axisFlip);
+                _bodyMesh.SetVertices(_bodyPositions);
+                _bodyMesh.SetNormals(_bodyNormals);
+                _bodyMesh.RecalculateBounds();
+            }
+        }
+
+        private void OnDisable() => Release();
+
+        private void Release()
+        {
+            if (_loop != null) _loop.Dispose();   // the context and its garment
+            _loop = null;
+            _garment = null;
+            if (_garmentMesh != null) Destroy(_garmentMesh);
+            if (_bodyMesh != null) Destroy(_bodyMesh);
+            _garmentMesh = null;
+            _bodyMesh = null;
+        }
+    }
+}
