@@ -1,0 +1,414 @@
+// Stress scenarios (issue 8, docs/robustness.md): real Kinect v2 takes from ../shared/data with a
+// perturbation applied to what the host pushes through the C ABI. Each scenario is compared with
+// the undisturbed run of the same take at the same frame times. Bounds: docs/robustness.md.
+#include "stress_support.h"
+
+namespace {
+
+using namespace stress;
+
+constexpr const char* kComeHere = "kinect_v2_msft_labanotation/Ges04_comehere.csv";   // 172 frames, 5.7 s
+constexpr const char* kBalance = "kinect_v2_msft_labanotation/Ges02_balancinghands.csv";  // 161 frames
+constexpr double kStart = 1.5;  // disturbances start here (after the 0.3 s blend-in and settling)
+
+// ---------------------------------------------------------------------------------------------
+// Frame times from 1/240 s to 1/10 s, fixed and irregular.
+
+TEST(StressFrameTimes, FixedRatesFrom240HzTo10Hz) {
+  STRESS_REQUIRE_TAKE(take, kComeHere);
+  const Series control = replay(take, fixedTimes(take.duration(), 1.0 / 30.0));
+  print("30 Hz (undisturbed)", control);
+  expectHealthy(control, "30 Hz");
+  for (double hz : {240.0, 120.0, 60.0, 15.0, 10.0}) {
+    const Series s = replay(take, fixedTimes(take.duration(), 1.0 / hz), nullptr, Dressing(), hz > 30 ? int(hz / 30) : 1);
+    const std::string name = std::to_string(int(hz)) + " Hz";
+    print(name.c_str(), s);
+    expectHealthy(s, name.c_str());
+    EXPECT_EQ(s.push_errors, 0);
+    // The same motion sampled more or less often: the stretch stays that of the 30 Hz run.
+    EXPECT_LE(s.medianP99(kStart, 1e9), control.medianP99(kStart, 1e9) + 0.05f) << name;
+    EXPECT_LE(s.maxP99(kStart, 1e9), control.maxP99(kStart, 1e9) + 0.15f) << name;
+  }
+}
+
+TEST(StressFrameTimes, IrregularFrom240HzTo10Hz) {
+  STRESS_REQUIRE_TAKE(take, kComeHere);
+  const Series control = replay(take, fixedTimes(take.duration(), 1.0 / 30.0));
+  for (unsigned seed : {1u, 2u, 3u}) {
+    std::mt19937 rng(seed);
+    // Log-uniform in [1/240, 1/10]: many short frames and some long stalls, as a busy host gives.
+    std::uniform_real_distribution<double> u(std::log(1.0 / 240.0), std::log(1.0 / 10.0));
+    const Series s = replay(take, frameTimes(take.duration(), [&] { return std::exp(u(rng)); }));
+    const std::string name = "irregular, seed " + std::to_string(seed);
+    print(name.c_str(), s);
+    expectHealthy(s, name.c_str());
+    EXPECT_EQ(s.push_errors, 0);
+    EXPECT_LE(s.medianP99(kStart, 1e9), control.medianP99(kStart, 1e9) + 0.05f) << name;
+    EXPECT_LE(s.maxP99(kStart, 1e9), control.maxP99(kStart, 1e9) + 0.15f) << name;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Teleports: the whole skeleton 2 m away for one frame, or for good.
+
+TEST(StressTeleport, TwoMetresForOneFrame) {
+  STRESS_REQUIRE_TAKE(take, kComeHere);
+  const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
+  const Series control = replay(take, times);
+  const double at = 2.0;
+  const Series s = replay(take, times, [&](double t, Joints& j) {
+    if (std::abs(t - at) < 0.5 / 30.0)
+      for (drape_joint& q : j) q.position.x += 2.0f;
+  });
+  print("teleport 2 m for one frame", s);
+  expectHealthy(s, "teleport one frame");
+  EXPECT_LE(s.maxP99(0, 1e9), 1.0f) << "P99 stretch bounded through the jump and back";
+  expectRecovered(s, control, at + 1.0 / 30.0, "teleport one frame");
+}
+
+TEST(StressTeleport, TwoMetresForGood) {
+  STRESS_REQUIRE_TAKE(take, kComeHere);
+  const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
+  const Series control = replay(take, times);
+  const double at = 2.0;
+  for (float dx : {2.0f, -2.0f}) {
+    const Series s = replay(take, times, [&](double t, Joints& j) {
+      if (t >= at - 0.5 / 30.0)
+        for (drape_joint& q : j) q.position.z += dx;
+    });
+    print(dx > 0 ? "teleport 2 m back for good" : "teleport 2 m forward for good", s);
+    expectHealthy(s, "teleport for good");
+    EXPECT_LE(s.maxP99(0, 1e9), 1.0f);
+    expectRecovered(s, control, at, "teleport for good");
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Gaussian jitter of 1-5 cm on every joint for two seconds.
+
+Series jittered(const Take& take, const std::vector<double>& times, float sigma, double end) {
+  std::mt19937 rng(7);
+  std::normal_distribution<float> n(0.0f, sigma);
+  return replay(take, times, [&](double t, Joints& j) {
+    if (t >= kStart && t < end)
+      for (drape_joint& q : j) q.position = drape_vec3{q.position.x + n(rng), q.position.y + n(rng), q.position.z + n(rng)};
+  });
+}
+
+TEST(StressJitter, GaussianOneToFiveCentimetres) {
+  STRESS_REQUIRE_TAKE(take, kComeHere);
+  const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
+  const Series control = replay(take, times);
+  const double end = kStart + 2.0;
+  for (float sigma : {0.01f, 0.02f, 0.05f}) {
+    const Series s = jittered(take, times, sigma, end);
+    const std::string name = "jitter sigma " + std::to_string(int(sigma * 100 + 0.5f)) + " cm";
+    print(name.c_str(), s);
+    expectHealthy(s, name.c_str());
+    if (sigma <= 0.02f) {
+      EXPECT_LE(s.maxP99(kStart, end), control.maxP99(kStart, end) + 0.15f) << name << ": during the jitter";
+      expectRecovered(s, control, end, name.c_str());
+    } else {
+      // 5 cm: bounded (measured worst frame 158 %), but not recovered one second later: see
+      // StressKnownIssues.DISABLED_RecoversFromFiveCentimetreJitter and docs/robustness.md.
+      EXPECT_LE(s.maxP99(kStart, end), 2.5f) << name << ": during the jitter";
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Joints not tracked for 30 frames, then back (Kinect reports them at the origin).
+
+TEST(StressTracking, JointsNotTrackedForThirtyFramesThenBack) {
+  STRESS_REQUIRE_TAKE(take, kComeHere);
+  const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
+  const Series control = replay(take, times);
+  const double end = kStart + 30.0 / 30.0;
+  struct Case {
+    const char* name;
+    std::vector<int> joints;
+  };
+  const Case cases[] = {
+      {"right arm not tracked", {ElbowR, WristR, HandR, 23, 24}},
+      {"both legs not tracked", {KneeL, AnkleL, FootL, KneeR, AnkleR, FootR}},
+      {"whole body not tracked", {}},
+  };
+  for (const Case& c : cases) {
+    const Series s = replay(take, times, [&](double t, Joints& j) {
+      if (t < kStart || t >= end) return;
+      if (c.joints.empty()) {
+        for (drape_joint& q : j) q = drape_joint{{0, 0, 0}, DRAPE_TRACKING_NOT_TRACKED};
+      } else {
+        for (int k : c.joints) j[k] = drape_joint{{0, 0, 0}, DRAPE_TRACKING_NOT_TRACKED};
+      }
+    });
+    print(c.name, s);
+    expectHealthy(s, c.name);
+    EXPECT_EQ(s.push_errors, 0) << c.name << ": NOT_TRACKED joints are valid input";
+    EXPECT_LE(s.maxP99(0, 1e9), 1.0f) << c.name;
+    expectRecovered(s, control, end, c.name);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Zero-length and reversed bones for one second.
+
+TEST(StressBones, ZeroLengthAndReversedBones) {
+  STRESS_REQUIRE_TAKE(take, kComeHere);
+  const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
+  const Series control = replay(take, times);
+  const double end = kStart + 1.0;
+  auto reflect = [](drape_joint& child, const drape_joint& parent) {
+    child.position = drape_vec3{2 * parent.position.x - child.position.x, 2 * parent.position.y - child.position.y,
+                                2 * parent.position.z - child.position.z};
+  };
+  struct Case {
+    const char* name;
+    std::function<void(Joints&)> f;
+  };
+  const Case cases[] = {
+      {"zero-length upper arms", [](Joints& j) { j[ElbowL].position = j[ShoulderL].position, j[ElbowR].position = j[ShoulderR].position; }},
+      {"zero-length spine", [](Joints& j) { j[SpineMid].position = j[SpineBase].position, j[SpineShoulder].position = j[SpineBase].position; }},
+      {"every joint at one point", [](Joints& j) { for (drape_joint& q : j) q.position = j[SpineBase].position; }},
+      {"reversed forearms", [&](Joints& j) { reflect(j[WristL], j[ElbowL]), reflect(j[WristR], j[ElbowR]); }},
+      {"reversed thighs (knees above hips)", [&](Joints& j) { reflect(j[KneeL], j[HipL]), reflect(j[KneeR], j[HipR]); }},
+  };
+  for (const Case& c : cases) {
+    const Series s = replay(take, times, [&](double t, Joints& j) {
+      if (t >= kStart && t < end) c.f(j);
+    });
+    print(c.name, s);
+    expectHealthy(s, c.name);
+    expectRecovered(s, control, end, c.name);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// NaN / Inf / 1e30 joints: refused with an error, the state bit-identical to a context that never
+// saw them. The same for refused steps, parameters and body shapes.
+
+TEST(StressBadInput, RefusedInputLeavesTheStateBitIdentical) {
+  STRESS_REQUIRE_TAKE(take, kComeHere);
+  Scene control, victim;
+  const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
+  struct Bad {
+    const char* name;
+    float value;
+    drape_result code;
+  };
+  const Bad bads[] = {{"NaN", NAN, DRAPE_ERROR_NONFINITE},     {"+Inf", INFINITY, DRAPE_ERROR_NONFINITE},
+                      {"-Inf", -INFINITY, DRAPE_ERROR_NONFINITE}, {"1e30", 1e30f, DRAPE_ERROR_OUT_OF_RANGE},
+                      {"-1e30", -1e30f, DRAPE_ERROR_OUT_OF_RANGE}, {"1001 m", 1001.0f, DRAPE_ERROR_OUT_OF_RANGE}};
+  int refused = 0;
+  for (size_t i = 0; i < times.size(); ++i) {
+    const Joints j = take.sample(times[i]);
+    const float dt = i == 0 ? 1.0f / 30.0f : static_cast<float>(times[i] - times[i - 1]);
+    if (i % 3 == 1) {  // before this frame, a bad one at a later timestamp, one joint or all of them
+      const Bad& b = bads[(i / 3) % 6];
+      Joints bad = j;
+      if (i % 2) bad[(i * 7) % 25].position.y = b.value;
+      else for (drape_joint& q : bad) q.position.x = b.value;
+      drape_skeleton_frame f;
+      std::memset(&f, 0, sizeof f);
+      f.struct_size = sizeof f;
+      f.layout = DRAPE_LAYOUT_KINECT2;
+      f.joint_count = 25;
+      f.timestamp_s = times[i] - 0.25 * dt;
+      f.joints = bad.data();
+      EXPECT_EQ(drape_context_push_skeleton(victim.context(), &f), b.code) << b.name << " at frame " << i;
+      ++refused;
+      // A bad dt, a bad parameter and a bad body shape are refused as well.
+      for (float bad_dt : {NAN, INFINITY, 0.0f, -1.0f / 30.0f, 10.5f})
+        EXPECT_NE(drape_context_step(victim.context(), bad_dt), DRAPE_OK) << "dt " << bad_dt;
+      drape_cloth_params c;
+      drape_cloth_params_init(&c);
+      c.stretch_compliance = b.value;
+      EXPECT_NE(drape_garment_set_params(victim.garment(), &c), DRAPE_OK);
+      drape_body_shape sh;
+      drape_body_shape_init(&sh);
+      sh.height_m = b.value;
+      EXPECT_NE(drape_context_set_body_shape(victim.context(), &sh), DRAPE_OK);
+    }
+    ASSERT_EQ(control.frame(j, times[i], dt, false), DRAPE_OK);
+    ASSERT_EQ(victim.frame(j, times[i], dt, false), DRAPE_OK) << lastError();
+    const std::vector<float> a = control.positions(), b = victim.positions();
+    ASSERT_EQ(a.size(), b.size());
+    ASSERT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0) << "garments differ after frame " << i;
+  }
+  drape_frame_stats sa, sb;
+  sa.struct_size = sb.struct_size = sizeof sa;
+  ASSERT_OK(drape_context_get_frame_stats(control.context(), &sa));
+  ASSERT_OK(drape_context_get_frame_stats(victim.context(), &sb));
+  EXPECT_EQ(sb.frames_rejected, static_cast<uint32_t>(refused));
+  EXPECT_EQ(sb.frames_accepted, sa.frames_accepted);
+  EXPECT_EQ(sb.updates, sa.updates);
+  EXPECT_EQ(sb.teleports, sa.teleports);
+  EXPECT_EQ(sb.last_timestamp_s, sa.last_timestamp_s);
+  EXPECT_EQ(sb.body_volume_l, sa.body_volume_l);
+  std::vector<drape_vec3> ka(21), kb(21);
+  ASSERT_OK(drape_context_read_skeleton(control.context(), ka.data(), 21, nullptr));
+  ASSERT_OK(drape_context_read_skeleton(victim.context(), kb.data(), 21, nullptr));
+  EXPECT_EQ(std::memcmp(ka.data(), kb.data(), 21 * sizeof(drape_vec3)), 0);
+  std::printf("[ figures  ] %d bad frames refused, garments bit-identical on all %zu frames\n", refused, times.size());
+  expectHealthy(victim.series, "victim");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Body shapes from BMI 15 to 45 and heights 1.0 to 2.2 m (the garment sized to that body).
+
+TEST(StressBodyShape, BmiFifteenToFortyFiveHeightOneToTwoPointTwo) {
+  STRESS_REQUIRE_TAKE(take, kBalance);
+  const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
+  for (float h : {1.0f, 1.6f, 2.2f})
+    for (float bmi : {15.0f, 25.0f, 45.0f}) {
+      Dressing setup;
+      setup.set_shape = true;
+      drape_body_shape_init(&setup.shape);
+      setup.shape.height_m = h;
+      setup.shape.weight_kg = bmi * h * h;
+      const Series s = replay(take, times, nullptr, setup, 2);
+      char name[64];
+      std::snprintf(name, sizeof name, "height %.1f m, BMI %.0f", h, bmi);
+      print(name, s);
+      expectHealthy(s, name);
+      EXPECT_LE(s.maxP99(0, 1e9), 1.3f) << name;  // measured worst 0.96 (2.2 m, BMI 25)
+    }
+}
+
+TEST(StressBodyShape, ShapeChangedUnderTheGarment) {
+  STRESS_REQUIRE_TAKE(take, kBalance);
+  Scene scene;
+  const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
+  const float shapes[][2] = {{1.0f, 15.0f}, {2.2f, 45.0f}, {1.7f, 22.5f}};
+  for (size_t i = 0; i < times.size(); ++i) {
+    if (i > 0 && i % 40 == 0) {
+      drape_body_shape sh;
+      drape_body_shape_init(&sh);
+      const float* hb = shapes[(i / 40 - 1) % 3];
+      sh.height_m = hb[0];
+      sh.weight_kg = hb[1] * hb[0] * hb[0];
+      ASSERT_OK(drape_context_set_body_shape(scene.context(), &sh));
+    }
+    scene.frame(take.sample(times[i]), times[i], i == 0 ? 1.0f / 30.0f : float(times[i] - times[i - 1]), true);
+  }
+  print("shape changed every 40 frames", scene.series);
+  expectHealthy(scene.series, "shape changes");
+  // The garment keeps the cut of the body it was added to: a 1.0 m / BMI 15 body put under a shirt
+  // cut for 1.70 m / 65 kg and then a 2.2 m / BMI 45 one stretch it hard (measured worst 290 %).
+  EXPECT_LE(scene.series.maxP99(0, 1e9), 4.0f);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Compliance and mass (area density) at the ends of their ranges.
+
+TEST(StressClothParams, ComplianceAndMassAtExtremes) {
+  STRESS_REQUIRE_TAKE(take, kComeHere);
+  const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
+  const Series control = replay(take, times, nullptr, Dressing(), 2);
+  struct Case {
+    const char* name;
+    float stretch, shear, bend, density;
+    float p99_bound;  // worst frame
+  };
+  const Case cases[] = {
+      {"all compliances 0, 0.001 kg/m2", 0.0f, 0.0f, 0.0f, 0.001f, -1.0f},
+      {"all compliances 0, 10 kg/m2", 0.0f, 0.0f, 0.0f, 10.0f, -1.0f},
+      {"bend and shear 1, 0.2 kg/m2", 0.0f, 1.0f, 1.0f, 0.2f, -1.0f},
+      {"stretch 1e-3, 10 kg/m2", 1e-3f, 1e-6f, 1e-3f, 10.0f, 3.0f},
+      {"all compliances 1, 0.001 kg/m2", 1.0f, 1.0f, 1.0f, 0.001f, 3.0f},
+      // 1 m/N on 10 kg/m2: the cloth sags under its own weight (measured worst 340 %), by design.
+      {"all compliances 1, 10 kg/m2", 1.0f, 1.0f, 1.0f, 10.0f, 4.5f},
+  };
+  for (const Case& c : cases) {
+    Dressing setup;
+    setup.set_desc = setup.set_cloth = true;
+    drape_garment_desc_init(&setup.desc);
+    setup.desc.area_density = c.density;
+    drape_cloth_params_init(&setup.cloth);
+    setup.cloth.stretch_compliance = c.stretch;
+    setup.cloth.shear_compliance = c.shear;
+    setup.cloth.bend_compliance = c.bend;
+    const Series s = replay(take, times, nullptr, setup, 2);
+    print(c.name, s);
+    expectHealthy(s, c.name);
+    if (c.p99_bound < 0) {  // inextensible: as stretched as the default cloth
+      EXPECT_LE(s.medianP99(kStart, 1e9), control.medianP99(kStart, 1e9) + 0.05f) << c.name;
+      EXPECT_LE(s.maxP99(0, 1e9), control.maxP99(0, 1e9) + 0.15f) << c.name;
+    } else {
+      EXPECT_LE(s.maxP99(0, 1e9), c.p99_bound) << c.name;
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// A long replay loop (the take forwards then backwards, over and over): no drift, no NaN.
+
+void loop(double minutes) {
+  STRESS_REQUIRE_TAKE(take, kComeHere);
+  Scene scene;
+  const int frames = static_cast<int>(minutes * 60.0 * 30.0);
+  for (int i = 0; i < frames; ++i) {
+    const double t = i / 30.0;
+    ASSERT_EQ(scene.frame(take.sampleLooped(t), t, 1.0f / 30.0f, i % 30 == 0), DRAPE_OK) << lastError();
+  }
+  const Series& s = scene.series;
+  const double end = s.t.back();
+  print("loop: first minute", s, 0.0, 60.0);
+  print("loop: last minute", s, end - 60.0, end);
+  expectHealthy(s, "loop");
+  EXPECT_EQ(s.push_errors, 0);
+  // No drift: the last minute as stretched as the first (the same motion, played again).
+  EXPECT_LE(s.medianP99(end - 60.0, end), s.medianP99(kStart, 60.0) + 0.03f);
+  EXPECT_LE(s.maxP99(end - 60.0, end), s.maxP99(kStart, 60.0) + 0.10f);
+  drape_garment_stats st;
+  st.struct_size = sizeof st;
+  ASSERT_OK(drape_garment_get_stats(scene.garment(), &st));
+  EXPECT_EQ(st.steps, static_cast<uint64_t>(frames));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Known issues (docs/robustness.md, found by this suite; the cloth is another issue's work): the
+// run stays finite and bounded (asserted above or here), but does not come back to the
+// undisturbed stretch within a second. Run with --gtest_also_run_disabled_tests.
+
+TEST(StressKnownIssues, UpsideDownSkeletonForOneSecondStaysFinite) {
+  STRESS_REQUIRE_TAKE(take, kComeHere);
+  const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
+  const double end = kStart + 1.0;
+  const Series s = replay(take, times, [&](double t, Joints& j) {
+    if (t < kStart || t >= end) return;
+    const drape_vec3 c = j[SpineBase].position;
+    for (drape_joint& q : j) q.position = drape_vec3{2 * c.x - q.position.x, 2 * c.y - q.position.y, 2 * c.z - q.position.z};
+  });
+  print("upside-down skeleton", s);
+  // Measured: particles up to 45 m/s on the frames after the flip, worst P99 332 %.
+  expectHealthy(s, "upside-down skeleton", 100.0f);
+  EXPECT_LE(s.maxP99(0, 1e9), 5.0f);
+}
+
+TEST(StressKnownIssues, DISABLED_RecoversFromUpsideDownSkeleton) {
+  STRESS_REQUIRE_TAKE(take, kComeHere);
+  const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
+  const Series control = replay(take, times);
+  const double end = kStart + 1.0;
+  const Series s = replay(take, times, [&](double t, Joints& j) {
+    if (t < kStart || t >= end) return;
+    const drape_vec3 c = j[SpineBase].position;
+    for (drape_joint& q : j) q.position = drape_vec3{2 * c.x - q.position.x, 2 * c.y - q.position.y, 2 * c.z - q.position.z};
+  });
+  expectHealthy(s, "upside-down skeleton");
+  expectRecovered(s, control, end, "upside-down skeleton");
+}
+
+TEST(StressKnownIssues, DISABLED_RecoversFromFiveCentimetreJitter) {
+  STRESS_REQUIRE_TAKE(take, kComeHere);
+  const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
+  const Series control = replay(take, times);
+  const Series s = jittered(take, times, 0.05f, kStart + 2.0);
+  expectRecovered(s, control, kStart + 2.0, "jitter sigma 5 cm");
+}
+
+TEST(StressLoop, ReplayLoopTenMinutes) { loop(10.0); }
+TEST(StressLoop, LongReplayLoopOneHour) { loop(60.0); }
+
+}  // namespace
