@@ -31,6 +31,15 @@ void* unregisterHandle(HandleKind kind, const void* token);
 // that do not already name it.
 void setCurrentFunction(const char* function);
 
+// Resolves a drape_context* argument into `Context* const var` or returns the error (NULL or not a
+// live context). For the entry points in capi_context.cpp and capi_garments.cpp.
+#define DRAPE_RESOLVE_CONTEXT(var, fn, handle)                                                     \
+  if (!(handle)) return ::drape::api::fail(DRAPE_ERROR_NULL_ARGUMENT, fn ": context is NULL");    \
+  ::drape::Context* const var =                                                                  \
+      static_cast<::drape::Context*>(::drape::api::resolveHandle(::drape::api::HandleKind::Context, handle)); \
+  if (!var)                                                                                      \
+  return ::drape::api::fail(DRAPE_ERROR_INVALID_HANDLE, fn ": context is not a live drape_context (destroyed or never created)")
+
 // Validates the struct_size field of a caller struct: at least the first released size.
 const char* lastError();
 

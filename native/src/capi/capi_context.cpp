@@ -15,12 +15,7 @@ void forgetGarments(Context& ctx);  // capi_garments.cpp
 
 namespace {
 
-// Resolves the handle into `self` (declared by the macro) or returns the error.
-#define DRAPE_CHECK_CONTEXT(fn, handle)                                                          \
-  if (!(handle)) return fail(DRAPE_ERROR_NULL_ARGUMENT, fn ": context is NULL");                 \
-  Context* const self = static_cast<Context*>(resolveHandle(HandleKind::Context, handle));      \
-  if (!self)                                                                                     \
-    return fail(DRAPE_ERROR_INVALID_HANDLE, fn ": context is not a live drape_context (destroyed or never created)")
+#define DRAPE_CHECK_CONTEXT(fn, handle) DRAPE_RESOLVE_CONTEXT(self, fn, handle)
 
 drape_result toShapeInput(const drape_body_shape& s, drape::BodyShapeInput& in) {
   in.sex = static_cast<drape::Sex>(s.sex);

@@ -15,11 +15,7 @@ using namespace drape::api;
 
 namespace {
 
-#define DRAPE_CHECK_CONTEXT(fn, handle)                                                          \
-  if (!(handle)) return fail(DRAPE_ERROR_NULL_ARGUMENT, fn ": context is NULL");                 \
-  Context* const ctx = static_cast<Context*>(resolveHandle(HandleKind::Context, handle));       \
-  if (!ctx)                                                                                      \
-    return fail(DRAPE_ERROR_INVALID_HANDLE, fn ": context is not a live drape_context (destroyed or never created)")
+#define DRAPE_CHECK_CONTEXT(fn, handle) DRAPE_RESOLVE_CONTEXT(ctx, fn, handle)
 
 #define DRAPE_CHECK_GARMENT(fn, handle)                                                          \
   if (!(handle)) return fail(DRAPE_ERROR_NULL_ARGUMENT, fn ": garment is NULL");                 \
@@ -490,13 +486,13 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_read_mesh(drape_garment* handle,
     if (indices && index_capacity < m)
       return fail(DRAPE_ERROR_BUFFER_TOO_SMALL, std::string(fn) + ": index_capacity " + std::to_string(index_capacity) +
                                                     " < " + std::to_string(m));
-    std::vector<drape::Vec3> nrm;
-    if (normals) garment->normals(nrm);  // may throw bad_alloc: before anything is written
+    // Computed before anything is written (the first call may throw bad_alloc).
+    const std::vector<drape::Vec3>* nrm = normals ? &garment->normals() : nullptr;
     const Eigen::Vector4f* x = garment->positions();
     if (positions)
       for (size_t i = 0; i < n; ++i) positions[i] = drape_vec3{x[i].x(), x[i].y(), x[i].z()};
     if (normals)
-      for (size_t i = 0; i < n; ++i) normals[i] = c3(nrm[i]);
+      for (size_t i = 0; i < n; ++i) normals[i] = c3((*nrm)[i]);
     if (indices) std::copy(garment->indices().begin(), garment->indices().end(), indices);
     return DRAPE_OK;
   });

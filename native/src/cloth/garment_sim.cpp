@@ -423,12 +423,13 @@ void GarmentSim::step(const BodyModel& body, const std::vector<Ellipsoid>& start
   last_.total_ms = msSince(t0);
 }
 
-void GarmentSim::normals(std::vector<Vec3>& out) const {
-  std::vector<Vec3> p(particleCount());
+const std::vector<Vec3>& GarmentSim::normals() const {
+  normal_positions_.resize(particleCount());
   const Eigen::Vector4f* x = solver_->x();
-  for (size_t i = 0; i < p.size(); ++i) p[i] = x[i].head<3>();
-  out.resize(p.size());
-  vertexNormals(p, mesh_.indices, out);
+  for (size_t i = 0; i < normal_positions_.size(); ++i) normal_positions_[i] = x[i].head<3>();
+  normals_.resize(normal_positions_.size());
+  vertexNormals(normal_positions_, mesh_.indices, normals_);
+  return normals_;
 }
 
 GarmentAccuracy GarmentSim::measure(const std::vector<Ellipsoid>& ellipsoids, const TriangleBvh* bvh) const {

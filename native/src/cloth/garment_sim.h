@@ -115,8 +115,9 @@ class GarmentSim {
   const std::vector<uint32_t>& indices() const { return mesh_.indices; }
   const GarmentTopology& topology() const { return topology_; }
   const GarmentMesh& mesh() const { return mesh_; }
-  // Area-weighted vertex normals of the current positions (resizes `out`).
-  void normals(std::vector<Vec3>& out) const;
+  // Area-weighted unit vertex normals of the current positions, computed on call into a buffer
+  // the garment owns (valid until the next call; no allocation after the first).
+  const std::vector<Vec3>& normals() const;
   // Collision groups: each particle belongs to the body chain nearest to it on the rest body and
   // collides only with the ellipsoids of the chains in its mask (bit c = Chain c): torso cloth
   // with torso and head, a sleeve with its arm, a trouser leg with its leg and the torso. Where
@@ -170,6 +171,7 @@ class GarmentSim {
   // Per-step scratch (sized once).
   std::vector<Vec3> pins_, scratch3_;
   std::vector<Ellipsoid> carried_start_;
+  mutable std::vector<Vec3> normal_positions_, normals_;  // normals() scratch
   GarmentStepStats last_;
   uint64_t steps_ = 0;
 };
