@@ -6,6 +6,9 @@ set -euo pipefail
 
 # libstb-dev (stb_image_write) and libgif-dev (giflib): drape-replay's PNG pictures and animated GIF.
 packages=(cmake g++ make libeigen3-dev ocl-icd-opencl-dev opencl-headers pocl-opencl-icd libstb-dev libgif-dev)
+# libbullet-dev: drape-bench's peer (Bullet's soft-body cloth in the same run); gnuplot-nox: its
+# run-time-vs-error PNGs (pngcairo terminal). Both optional to the build (docs/benchmarks.md).
+packages+=(libbullet-dev gnuplot-nox)
 if [[ "${1:-}" != "--runtime-only" ]]; then
   # clang-15 brings libFuzzer (libclang-common-15-dev) for the fuzz targets tests/run.sh runs.
   packages+=(googletest libgtest-dev libbenchmark-dev clang-15)

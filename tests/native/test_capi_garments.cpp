@@ -164,6 +164,8 @@ TEST(CApiGarments, BadParametersAreRejectedAndChangeNothing) {
       {"contact response 7", [](drape_cloth_params& p) { p.contact_response = 7; }, DRAPE_ERROR_OUT_OF_RANGE},
       {"inertia above 1", [](drape_cloth_params& p) { p.linear_inertia = 1.5f; }, DRAPE_ERROR_OUT_OF_RANGE},
       {"negative spring", [](drape_cloth_params& p) { p.spring_stretch = -3.0f; }, DRAPE_ERROR_OUT_OF_RANGE},
+      {"iterations 0", [](drape_cloth_params& p) { p.iterations = 0; }, DRAPE_ERROR_OUT_OF_RANGE},
+      {"iterations 65", [](drape_cloth_params& p) { p.iterations = 65; }, DRAPE_ERROR_OUT_OF_RANGE},
       {"reserved", [](drape_cloth_params& p) { p.reserved = 1; }, DRAPE_ERROR_INVALID_ARGUMENT},
       {"struct_size", [](drape_cloth_params& p) { p.struct_size = 8; }, DRAPE_ERROR_INVALID_ARGUMENT},
   };

@@ -371,22 +371,11 @@ void loop(double minutes) {
 // run stays finite and bounded (asserted above or here), but does not come back to the
 // undisturbed stretch within a second. Run with --gtest_also_run_disabled_tests.
 
-TEST(StressKnownIssues, UpsideDownSkeletonForOneSecondStaysFinite) {
-  STRESS_REQUIRE_TAKE(take, kComeHere);
-  const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
-  const double end = kStart + 1.0;
-  const Series s = replay(take, times, [&](double t, Joints& j) {
-    if (t < kStart || t >= end) return;
-    const drape_vec3 c = j[SpineBase].position;
-    for (drape_joint& q : j) q.position = drape_vec3{2 * c.x - q.position.x, 2 * c.y - q.position.y, 2 * c.z - q.position.z};
-  });
-  print("upside-down skeleton", s);
-  // Measured: particles up to 45 m/s on the frames after the flip, worst P99 332 %.
-  expectHealthy(s, "upside-down skeleton", 100.0f);
-  EXPECT_LE(s.maxP99(0, 1e9), 5.0f);
-}
-
-TEST(StressKnownIssues, DISABLED_RecoversFromUpsideDownSkeleton) {
+// A skeleton flipped upside down for one second (every joint reflected through the pelvis), then
+// back. The pelvis does not move, so the tracker sees no teleport; the garment notices a pelvis
+// rotation no person makes in a frame and is placed on the new pose by ring skinning
+// (GarmentSim::poseJumped). Before that, particles reached 45 m/s, P99 332 %, no recovery.
+TEST(StressPose, UpsideDownSkeletonForOneSecondThenBack) {
   STRESS_REQUIRE_TAKE(take, kComeHere);
   const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
   const Series control = replay(take, times);
@@ -396,9 +385,17 @@ TEST(StressKnownIssues, DISABLED_RecoversFromUpsideDownSkeleton) {
     const drape_vec3 c = j[SpineBase].position;
     for (drape_joint& q : j) q.position = drape_vec3{2 * c.x - q.position.x, 2 * c.y - q.position.y, 2 * c.z - q.position.z};
   });
+  print("upside-down skeleton", s);
+  // Measured: worst P99 65 % (the shirt hangs off the upside-down body), 4.8 m/s.
   expectHealthy(s, "upside-down skeleton");
+  EXPECT_LE(s.maxP99(0, 1e9), 1.0f);
   expectRecovered(s, control, end, "upside-down skeleton");
 }
+
+// ---------------------------------------------------------------------------------------------
+// Known issue (docs/robustness.md): bounded and finite (asserted in StressJitter), but the
+// garment does not come back to the undisturbed stretch within a second. Run with
+// --gtest_also_run_disabled_tests.
 
 TEST(StressKnownIssues, DISABLED_RecoversFromFiveCentimetreJitter) {
   STRESS_REQUIRE_TAKE(take, kComeHere);

@@ -107,8 +107,9 @@ namespace Drape.Tests
             Assert.Equal(GarmentKind.Skirt, GarmentTemplate.CreateDefault(GarmentKind.Skirt).Kind);
 
             ClothParams c = ClothParams.CreateDefault();
-            Assert.Equal(124u, c.StructSize);
+            Assert.Equal(128u, c.StructSize);
             Assert.Equal(300f, c.SubstepHz);
+            Assert.Equal(1u, c.Iterations);
             Assert.Equal(200u, c.MaxSubsteps);
             Assert.Equal(new Vector3f(0f, -9.81f, 0f), c.Gravity);
             Assert.Equal(ContactResponse.Exact, c.ContactResponse);

@@ -510,7 +510,7 @@ namespace Drape
         }
     }
 
-    /// <summary>drape_cloth_params (124 bytes): the cloth parameters of a garment; they may change
+    /// <summary>drape_cloth_params (128 bytes): the cloth parameters of a garment; they may change
     /// at any time (<see cref="Garment.Params"/>). Start from <see cref="CreateDefault"/>. Ranges are
     /// checked by the library as a whole: NaN/Inf gives <see cref="ResultCode.NonFinite"/>, a value
     /// outside its range <see cref="ResultCode.OutOfRange"/>.</summary>
@@ -571,6 +571,9 @@ namespace Drape
         public float SpringBend;
         /// <summary>spring_damping: mass-spring solver only, N s/m along each spring; default 0.01.</summary>
         public float SpringDamping;
+        /// <summary>iterations: XPBD constraint passes per substep, [1, 64]; default 1 (the
+        /// mass-spring solver ignores it).</summary>
+        public uint Iterations;
         /// <summary>reserved: 0.</summary>
         public uint Reserved;
 

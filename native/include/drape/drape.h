@@ -428,6 +428,9 @@ typedef struct drape_cloth_params {
   float spring_shear;          /* N/m; 20 */
   float spring_bend;           /* N/m; 2 */
   float spring_damping;        /* N s/m along each spring; 0.01 */
+  uint32_t iterations;         /* XPBD constraint passes per substep, [1, 64]; 1 (the method: more
+                                  substeps beat more passes; drape-bench prices both). The
+                                  mass-spring solver has no passes and ignores it */
   uint32_t reserved;           /* must be 0 */
 } drape_cloth_params;
 
@@ -582,6 +585,80 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_measure(drape_garment* garment,
                                                         drape_garment_accuracy* out_accuracy);
 
 /* ------------------------------------------------------------------------------------------ */
+/* Adaptive pipeline                                                                           */
+/* ------------------------------------------------------------------------------------------ */
+
+/* What a context skips when the scene does not need it (docs/adaptive.md). All on by default;
+ * what the host reads is the same either way, only when it is computed changes:
+ *  - cull_proxies: only the tracking ellipsoids some awake garment can reach (from its attachments
+ *    and the length of cloth hanging from them) are built each update, and each garment collides
+ *    with its own. drape_context_read_ellipsoids, _read_ellipsoid_matrices, _measure_proxy_fidelity
+ *    and drape_garment_measure build the rest for the current frame first.
+ *  - stages_on_demand: the body mesh's positions and normals are computed when read
+ *    (drape_context_read_body_mesh), measured (fidelity, garment accuracy) or needed by
+ *    drape_context_get_frame_stats (body volume), not on every update. Off: every update computes
+ *    them (a host that reads the mesh every frame gains nothing from laziness).
+ *  - sleep: a garment whose particles have all moved slower than sleep_speed_m_s for
+ *    sleep_delay_s while every joint stayed within sleep_distance_m of where it was skips its steps.
+ *    It wakes, before anything is built for that frame, when a joint leaves that distance, on a
+ *    teleport, a new body shape, new cloth parameters (drape_garment_set_params), new pipeline
+ *    options or drape_context_wake; its first step sweeps the body from where it fell asleep, so
+ *    it continues without a jump.
+ * Choosing the cloth backend by garment size (CPU or OpenCL) is the backend's option, not this. */
+typedef enum drape_pipeline_stage {
+  DRAPE_STAGE_BODY_MESH = 1,     /* body vertex positions */
+  DRAPE_STAGE_BODY_NORMALS = 2,  /* body vertex normals */
+  DRAPE_STAGE_PROXIES = 4,       /* some tracking ellipsoids (culled) */
+  DRAPE_STAGE_CLOTH = 8,         /* some garment's step (asleep) */
+  DRAPE_STAGE_FORCE32 = 0x7fffffff
+} drape_pipeline_stage;
+
+typedef struct drape_pipeline_options {
+  uint32_t struct_size;      /* sizeof(drape_pipeline_options), set by drape_pipeline_options_init */
+  uint32_t cull_proxies;     /* 0 or 1; 1 */
+  uint32_t stages_on_demand; /* 0 or 1; 1 */
+  uint32_t sleep;            /* 0 or 1; 1 */
+  float sleep_delay_s;       /* stillness before a garment sleeps, [0, 60]; 0.5 */
+  float sleep_distance_m;    /* joints within this of where they were are still, [0, 1]; 0.005 */
+  float sleep_speed_m_s;     /* particles slower than this are still, [0, 10]; 0.02 */
+  float reach_margin_m;      /* added to each garment's reach (a frame of body motion), [0, 2]; 0.1 */
+  uint32_t reserved;         /* must be 0 */
+} drape_pipeline_options;
+
+/* Fills `options` with the defaults (everything adaptive on) and struct_size. */
+DRAPE_API drape_result DRAPE_CALL drape_pipeline_options_init(drape_pipeline_options* options);
+/* Replaces the context's options (validated as a whole; on failure nothing changes). Wakes every
+ * garment. Takes effect at the next update or step; turning stages_on_demand off computes the
+ * current frame's mesh at once. */
+DRAPE_API drape_result DRAPE_CALL drape_context_set_pipeline_options(drape_context* context,
+                                                                     const drape_pipeline_options* options);
+/* `out_options->struct_size` must be set by the caller (drape_pipeline_options_init does). */
+DRAPE_API drape_result DRAPE_CALL drape_context_get_pipeline_options(drape_context* context,
+                                                                     drape_pipeline_options* out_options);
+/* Wakes every sleeping garment: the next step runs them all (e.g. after the host moved something
+ * Drape does not see). */
+DRAPE_API drape_result DRAPE_CALL drape_context_wake(drape_context* context);
+
+/* What the adaptive pipeline skipped. "Frame": the last update (stages) or step (cloth). */
+typedef struct drape_skip_stats {
+  uint32_t struct_size;         /* caller sets sizeof(drape_skip_stats) */
+  uint32_t proxies_available;   /* tracking ellipsoids the body has */
+  uint32_t proxies_built;       /* of which the last update built (0 before the first update) */
+  uint32_t stages_skipped_last; /* drape_pipeline_stage bits skipped in the last frame so far */
+  uint32_t garments;            /* garments in the context */
+  uint32_t garments_asleep;     /* of which asleep now */
+  uint64_t updates;             /* updates that built the body for a new frame */
+  uint64_t stages_skipped;      /* stage runs skipped so far (each bit of each frame counts 1) */
+  uint64_t proxies_skipped;     /* ellipsoid builds skipped so far */
+  uint64_t steps;               /* steps with at least one garment */
+  uint64_t frames_slept;        /* of which steps in which every garment slept */
+  uint64_t garment_steps_slept; /* garment steps skipped */
+} drape_skip_stats;
+
+DRAPE_API drape_result DRAPE_CALL drape_context_get_skip_stats(drape_context* context,
+                                                               drape_skip_stats* out_stats);
+
+/* ------------------------------------------------------------------------------------------ */
 /* Recordings                                                                                  */
 /* ------------------------------------------------------------------------------------------ */
 
@@ -628,6 +705,77 @@ DRAPE_API drape_result DRAPE_CALL drape_recording_read_frame(drape_recording* re
 /* Writes the recording in Drape's own format to `path`. */
 DRAPE_API drape_result DRAPE_CALL drape_recording_save(drape_recording* recording,
                                                        const char* path);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Backends                                                                                    */
+/* ------------------------------------------------------------------------------------------ */
+/* Where a context's garments run their cloth step (docs/opencl.md): the CPU, or an OpenCL 1.2
+ * device (a GPU, or a CPU through PoCL) running the same XPBD step as kernels, the same answers
+ * within float rounding. Only the XPBD solver has an OpenCL path (mass-spring stays on the CPU).
+ * When OpenCL is asked for and no device works (no platform, bad index, the program does not
+ * build, the device fails later), garments run on the CPU and drape_context_get_backend_info
+ * says why: asking for OpenCL never makes a context unusable. */
+
+typedef enum drape_backend {
+  DRAPE_BACKEND_CPU = 0,     /* default */
+  DRAPE_BACKEND_OPENCL = 1,  /* every XPBD garment on the chosen device */
+  DRAPE_BACKEND_AUTO = 2,    /* OpenCL for garments of at least opencl_min_particles when a device works */
+  DRAPE_BACKEND_FORCE32 = 0x7fffffff
+} drape_backend;
+
+typedef struct drape_backend_desc {
+  uint32_t struct_size;            /* caller sets sizeof(drape_backend_desc) */
+  int32_t backend;                 /* drape_backend; default DRAPE_BACKEND_CPU */
+  int32_t platform_index;          /* OpenCL platform, -1 = choose (default); [-1, 255] */
+  int32_t device_index;            /* device within the platform (or among all when the platform
+                                      is -1), -1 = choose (default); [-1, 255] */
+  uint32_t prefer_gpu;             /* when choosing: a GPU before other devices (default 1); 0 or 1 */
+  uint32_t opencl_min_particles;   /* AUTO: smaller garments stay on the CPU (default 2000); [0, 1e8] */
+  void* host_cl_context;           /* optional: the host's cl_context and cl_command_queue (both or */
+  void* host_cl_queue;             /* neither); the indices are then ignored. Drape retains them. */
+} drape_backend_desc;
+
+DRAPE_API drape_result DRAPE_CALL drape_backend_desc_init(drape_backend_desc* desc);
+
+/* Chooses the backend of every garment of the context, now and when added later. With OpenCL,
+ * the device is chosen and the kernels are built here (PoCL: seconds; contexts asking for the same
+ * device share one build). Garments keep their positions and velocities across the switch.
+ * Returns DRAPE_OK when OpenCL was asked for but cannot run (see drape_backend_info). */
+DRAPE_API drape_result DRAPE_CALL drape_context_set_backend(drape_context* context,
+                                                            const drape_backend_desc* desc);
+
+typedef struct drape_backend_info {
+  uint32_t struct_size;            /* caller sets sizeof(drape_backend_info) */
+  int32_t requested;               /* drape_backend last asked for */
+  int32_t active;                  /* DRAPE_BACKEND_OPENCL when a device is in use, else CPU */
+  uint32_t opencl_garments;        /* garments stepping on the device */
+  uint32_t cpu_garments;           /* garments stepping on the CPU */
+  uint32_t reserved;
+  char device_name[128];           /* the OpenCL device ("" without one), NUL-terminated */
+  char platform_name[128];
+  char fallback_reason[512];       /* why OpenCL was asked for and is not (fully) used, else "" */
+} drape_backend_info;
+
+DRAPE_API drape_result DRAPE_CALL drape_context_get_backend_info(drape_context* context,
+                                                                 drape_backend_info* out_info);
+
+/* OpenCL devices on this machine, in enumeration order (platform by platform). */
+typedef struct drape_opencl_device {
+  uint32_t struct_size;            /* caller sets sizeof(drape_opencl_device) */
+  int32_t platform_index;
+  int32_t device_index;
+  uint32_t is_gpu;
+  uint64_t global_mem_bytes;
+  uint64_t local_mem_bytes;
+  uint32_t compute_units;
+  uint32_t reserved;
+  char platform_name[128];
+  char device_name[128];
+} drape_opencl_device;
+
+/* Number of OpenCL devices: 0 (DRAPE_OK) without an OpenCL driver or in a build without OpenCL. */
+DRAPE_API drape_result DRAPE_CALL drape_opencl_device_count(uint32_t* out_count);
+DRAPE_API drape_result DRAPE_CALL drape_opencl_device_get(uint32_t index, drape_opencl_device* out_device);
 
 #ifdef __cplusplus
 } /* extern "C" */

@@ -77,7 +77,8 @@ BodyModel::BodyModel(const ResolvedShape& shape, const BodyModelParams& params)
   normals_.assign(positions_.size(), Vec3::UnitY());
   const SkeletonPose rest = restPose(shape_);
   placeRings(rest);
-  writeVertices(rest);
+  writeVertices();
+  writeApexes(rest);
   buildTopology();
   computeNormals();
 }
@@ -289,7 +290,7 @@ void BodyModel::placeRings(const SkeletonPose& pose) {
 // Vertices: ring points (paper eq. 1-2 with the corrected order: scale, rotate, translate),
 // crotch bridge and the apexes that close head, hands and feet.
 // ---------------------------------------------------------------------------------------------
-void BodyModel::writeVertices(const SkeletonPose& pose) {
+void BodyModel::writeVertices() {
   const int K = K_;
   for (size_t r = 0; r < rings_.size(); ++r) {
     const RingPose& rp = rings_[r];
@@ -312,6 +313,9 @@ void BodyModel::writeVertices(const SkeletonPose& pose) {
     const float u = static_cast<float>(b + 1) / static_cast<float>(bridgeCount_ + 1);
     positions_[bridgeFirst_ + b] = front + u * (back - front) + down * (drop * std::sqrt(std::sin(kPi * u)));
   }
+}
+
+void BodyModel::writeApexes(const SkeletonPose& pose) {
   // Apexes: beyond the last ring of each open chain, along that ring's axis.
   const float H = shape_.input.height_m;
   const float headR = shape_[Measure::Head] / (2.0f * kPi);
@@ -329,9 +333,18 @@ void BodyModel::writeVertices(const SkeletonPose& pose) {
 void BodyModel::computeNormals() { vertexNormals(positions_, indices_, normals_); }
 
 void BodyModel::update(const SkeletonPose& pose) {
-  placeRings(pose);
-  writeVertices(pose);
-  computeNormals();
+  updateRings(pose);
+  updateMesh();
+  updateNormals();
 }
+
+void BodyModel::updateRings(const SkeletonPose& pose) {
+  placeRings(pose);
+  writeApexes(pose);
+}
+
+void BodyModel::updateMesh() { writeVertices(); }
+
+void BodyModel::updateNormals() { computeNormals(); }
 
 }  // namespace drape

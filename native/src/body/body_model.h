@@ -65,7 +65,15 @@ class BodyModel {
   void setShape(const ResolvedShape& shape);
 
   // Places every ring on the pose and rewrites positions and normals. No allocation.
+  // The same as updateRings(pose); updateMesh(); updateNormals().
   void update(const SkeletonPose& pose);
+  // The stages of update(), for callers that need only part of the body this frame (the
+  // adaptive pipeline, capi/adaptive.h): rings and the apex vertices (what the tracking
+  // ellipsoids read); the other vertices (ring points, crotch bridge) from the rings; normals from
+  // the vertices. Each stage reads only what the previous ones wrote.
+  void updateRings(const SkeletonPose& pose);
+  void updateMesh();
+  void updateNormals();
 
   const std::vector<RingStation>& stations() const { return stations_; }
   const std::vector<RingPose>& rings() const { return rings_; }
@@ -87,7 +95,8 @@ class BodyModel {
   void buildStations();
   void buildTopology();
   void placeRings(const SkeletonPose& pose);
-  void writeVertices(const SkeletonPose& pose);
+  void writeVertices();
+  void writeApexes(const SkeletonPose& pose);
   void computeNormals();
 
   ResolvedShape shape_;

@@ -217,6 +217,8 @@ DRAPE_API drape_result DRAPE_CALL drape_context_read_body_mesh(drape_context* co
     if ((positions || normals) && !ctx->hasUpdate())
       return fail(DRAPE_ERROR_CALL_ORDER,
                   "drape_context_read_body_mesh: positions and normals exist after the first successful update");
+    // Stages on demand: the mesh (and normals) of the last update are computed now if skipped.
+    if (positions || normals) ctx->bodyMesh(normals != nullptr);
     static_assert(sizeof(drape_vec3) == 3 * sizeof(float), "drape_vec3 must be three packed floats");
     if (positions)
       for (size_t i = 0; i < nv; ++i) {
@@ -253,7 +255,7 @@ DRAPE_API drape_result DRAPE_CALL drape_context_get_ellipsoid_count(drape_contex
   return guarded("drape_context_get_ellipsoid_count", [&]() -> drape_result {
     DRAPE_CHECK_CONTEXT("drape_context_get_ellipsoid_count", context);
     if (!out_count) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_get_ellipsoid_count: out_count is NULL");
-    *out_count = static_cast<uint32_t>(self->proxies().ellipsoids().size());
+    *out_count = static_cast<uint32_t>(self->ellipsoidCount());
     return DRAPE_OK;
   });
 }

@@ -82,6 +82,7 @@ drape_result toSimParams(const char* fn, const drape_cloth_params& c, drape::Gar
   k.range(w, "spring_shear", c.spring_shear, 0.0f, 1e6f);
   k.range(w, "spring_bend", c.spring_bend, 0.0f, 1e6f);
   k.range(w, "spring_damping", c.spring_damping, 0.0f, 1e6f);
+  k.range(w, "iterations", static_cast<float>(c.iterations), 1.0f, 64.0f);
   k.reserved(w, c.reserved);
   if (drape_result r = k.done(fn)) return r;
   drape::GarmentSimParams p;
@@ -111,6 +112,7 @@ drape_result toSimParams(const char* fn, const drape_cloth_params& c, drape::Gar
   p.mass_spring.shear_stiffness = c.spring_shear;
   p.mass_spring.bend_stiffness = c.spring_bend;
   p.mass_spring.spring_damping = c.spring_damping;
+  p.xpbd.iterations = static_cast<int>(c.iterations);
   const std::string e = drape::validate(p);
   if (!e.empty()) return fail(DRAPE_ERROR_OUT_OF_RANGE, std::string(fn) + ": cloth params: " + e);
   out = p;
@@ -146,6 +148,7 @@ void fromSimParams(const drape::GarmentSimParams& p, drape_cloth_params& c) {
   c.spring_shear = p.mass_spring.shear_stiffness;
   c.spring_bend = p.mass_spring.bend_stiffness;
   c.spring_damping = p.mass_spring.spring_damping;
+  c.iterations = static_cast<uint32_t>(p.xpbd.iterations);
 }
 
 // Resolves the optional desc and cloth structs (NULL: defaults) and validates them.
@@ -433,6 +436,8 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_set_params(drape_garment* handle
     if (drape_result r = toSimParams(fn, *params, sim)) return r;
     std::string err;
     if (!garment->setParams(sim, err)) return fail(DRAPE_ERROR_OUT_OF_RANGE, std::string(fn) + ": " + err);
+    // New parameters change how the cloth hangs: a sleeping garment steps again (adaptive.h).
+    static_cast<Context*>(garment->api_owner)->wakeGarment(garment);
     return DRAPE_OK;
   });
 }
@@ -580,4 +585,4 @@ static_assert(sizeof(drape_garment_template) == 24, "drape_garment_template layo
 static_assert(sizeof(drape_mesh_fit) == 48, "drape_mesh_fit layout");
 static_assert(sizeof(drape_garment_stats) == 72, "drape_garment_stats layout");
 static_assert(sizeof(drape_garment_accuracy) == 32, "drape_garment_accuracy layout");
-static_assert(sizeof(drape_cloth_params) == 124, "drape_cloth_params layout");
+static_assert(sizeof(drape_cloth_params) == 128, "drape_cloth_params layout");

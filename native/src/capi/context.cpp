@@ -111,6 +111,9 @@ drape_result Context::setShape(const BodyShapeInput& in, std::string& err) {
   restBody_.reset();
   shapeDirty_ = true;
   volumeDirty_ = true;
+  // The body changes under sleeping garments, and the ellipsoids' bounds with the rest body.
+  wakeAll();
+  proxyBounds_.clear();
   return DRAPE_OK;
 }
 
@@ -203,6 +206,7 @@ drape_result Context::update(std::string& err) {
   } else if (!shapeDirty_) {
     return DRAPE_OK;  // nothing new
   }
+  const bool newPose = updates_ != skips_.updates;
   const SkeletonPose& pose = tracker_.pose();
   for (const Vec3& p : pose.position) {
     if (!isFinite(p)) {
@@ -213,11 +217,20 @@ drape_result Context::update(std::string& err) {
       return DRAPE_ERROR_INTERNAL;
     }
   }
+  finishFrameCounters();
+  skips_.updates = updates_;
+  // A body that moved wakes the garments before anything is built for the frame.
+  if (newPose) adaptive_.observePose(pose, teleported_, options_);
   const auto t1 = Clock::now();
-  body_->update(pose);
+  body_->updateRings(pose);
+  meshFresh_ = normalsFresh_ = !options_.stages_on_demand;
+  if (meshFresh_) {
+    body_->updateMesh();
+    body_->updateNormals();
+  }
   bodyMs_ = msSince(t1);
   const auto t2 = Clock::now();
-  proxies_.build(*body_, pose);
+  buildProxies(pose);
   proxiesMs_ = msSince(t2);
   updated_ = true;
   shapeDirty_ = false;
@@ -227,7 +240,8 @@ drape_result Context::update(std::string& err) {
 
 void Context::fillStats(drape_frame_stats& out) {
   if (updated_ && volumeDirty_) {
-    volumeL_ = static_cast<float>(1000.0 * signedVolume(body_->positions(), body_->indices()));
+    const BodyModel& body = bodyMesh(false);
+    volumeL_ = static_cast<float>(1000.0 * signedVolume(body.positions(), body.indices()));
     volumeDirty_ = false;
   }
   out.frames_pushed = pushed_;
@@ -253,6 +267,7 @@ namespace drape {
 
 void Context::refreshBvh() {
   // The topology never changes, so after the first build a refit follows the moved vertices.
+  bodyMesh(false);
   if (!bvhBuilt_) {
     bvh_.build(body_->positions(), body_->indices());
     bvhBuilt_ = true;
@@ -263,7 +278,7 @@ void Context::refreshBvh() {
 
 FidelityReport Context::measureFidelity() {
   refreshBvh();
-  const auto& e = proxies_.ellipsoids();
+  const auto& e = proxies().ellipsoids();
   return drape::measureFidelity(body_->positions(), body_->indices(), e.data(), static_cast<int>(e.size()), bvh_);
 }
 
@@ -299,13 +314,21 @@ const std::vector<Ellipsoid>& Context::restEllipsoids() {
 }
 
 GarmentSim* Context::adoptGarment(std::unique_ptr<GarmentSim> garment) {
+  ReachParams rp;
+  rp.margin_m = options_.reach_margin_m;
+  std::vector<ReachSphere> reach = garmentReach(*garment, rp);
   garments_.push_back(std::move(garment));
+  adaptive_.addGarment(garments_.back().get(), std::move(reach));
+  reachDirty_ = true;
+  applyBackend(*garments_.back());
   return garments_.back().get();
 }
 
 bool Context::removeGarment(const GarmentSim* garment) {
   for (auto it = garments_.begin(); it != garments_.end(); ++it) {
     if (it->get() == garment) {
+      adaptive_.removeGarment(garment);
+      reachDirty_ = true;
       garments_.erase(it);
       return true;
     }
@@ -328,11 +351,37 @@ drape_result Context::step(float dt, std::string& err) {
   }
   if (drape_result r = update(err)) return r;
   const auto t0 = Clock::now();
+  // Woken or new garments, or new options, since the frame's ellipsoids were built.
+  if (reachDirty_ && updated_) buildProxies(tracker_.pose());
   const std::vector<Ellipsoid>& now = proxies_.ellipsoids();
   if (stepEllipsoids_.size() != now.size()) stepEllipsoids_ = now;
-  for (auto& g : garments_) g->step(*body_, stepEllipsoids_, now, dt, teleportPending_);
+  // An ellipsoid culled at the last step and built now has no start value: it starts still (it
+  // was out of every garment's reach by the reach margin, so no particle is near it).
+  for (size_t k = 0; k < now.size() && k < fresh_.size(); ++k)
+    if (fresh_[k] && !(k < freshAtStep_.size() && freshAtStep_[k])) stepEllipsoids_[k] = now[k];
+  adaptive_.advance(dt);
+  size_t slept = 0;
+  for (auto& g : garments_) {
+    if (options_.sleep && adaptive_.asleep(g.get())) {
+      g->markSkipped();
+      ++slept;
+      continue;
+    }
+    const std::vector<Ellipsoid>* woke = adaptive_.wakeStart(g.get(), now);
+    g->step(*body_, woke ? *woke : stepEllipsoids_, now, dt, teleportPending_);
+    adaptive_.afterStep(*g, now, dt, options_);
+  }
+  checkDeviceFailures();
+  clothSkippedLast_ = slept > 0;
+  if (!garments_.empty()) {
+    ++skips_.steps;
+    skips_.garment_steps_slept += slept;
+    if (slept == garments_.size()) ++skips_.frames_slept;
+    if (slept > 0) ++skips_.stages_skipped;
+  }
   teleportPending_ = false;
   stepEllipsoids_ = now;
+  freshAtStep_ = fresh_;
   stepMs_ = msSince(t0);
   return DRAPE_OK;
 }
@@ -340,7 +389,7 @@ drape_result Context::step(float dt, std::string& err) {
 GarmentAccuracy Context::measureGarment(const GarmentSim& garment) {
   if (!updated_) return garment.measure(restEllipsoids(), nullptr);
   refreshBvh();
-  return garment.measure(proxies_.ellipsoids(), &bvh_);
+  return garment.measure(proxies().ellipsoids(), &bvh_);
 }
 
 }  // namespace drape

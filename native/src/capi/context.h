@@ -3,6 +3,7 @@
 #pragma once
 
 #include "body/body_model.h"
+#include "capi/adaptive.h"
 #include "body/body_shape.h"
 #include "cloth/garment_sim.h"
 #include "proxies/fidelity.h"
@@ -33,9 +34,14 @@ class Context {
   void countRejectedFrame() { ++pushed_; ++rejected_; }
 
   const ResolvedShape& shape() const { return shape_; }
+  // The body's rings are current after every update; its mesh (positions, normals) only when
+  // read through bodyMesh() (stages on demand, capi/adaptive.h).
   const BodyModel& body() const { return *body_; }
+  const BodyModel& bodyMesh(bool normals);
   const SkeletonTracker& tracker() const { return tracker_; }
-  const ProxyBuilder& proxies() const { return proxies_; }
+  // Every ellipsoid of the last update (culled ones are built now if they were skipped).
+  const ProxyBuilder& proxies();
+  size_t ellipsoidCount() const { return proxies_.ellipsoids().size(); }
   // Fidelity of the current ellipsoids against the current body mesh (a diagnostic: ~ms).
   FidelityReport measureFidelity();
   bool hasUpdate() const { return updated_; }
@@ -57,7 +63,20 @@ class Context {
   // Accuracy of a garment now, against the ellipsoids and the body mesh of the last update.
   GarmentAccuracy measureGarment(const GarmentSim& garment);
   double lastStepMs() const { return stepMs_; }
+  // Backends (docs/opencl.md; capi/context_backend.cpp). desc validated by the caller. Moves every
+  // garment to the chosen backend; OpenCL trouble falls back to the CPU with the reason kept.
+  drape_result setBackend(const drape_backend_desc& desc, std::string& err);
+  void backendInfo(drape_backend_info& out) const;
   void fillStats(drape_frame_stats& out);
+
+  // The adaptive pipeline (capi/adaptive.h, docs/adaptive.md). Options must be valid.
+  void setPipelineOptions(const PipelineOptions& o);
+  const PipelineOptions& pipelineOptions() const { return options_; }
+  SkipCounters skipCounters() const;
+  // Wakes every sleeping garment / one garment (new cloth parameters); the next step runs it.
+  void wakeAll();
+  void wakeGarment(const GarmentSim* garment);
+  bool garmentAsleep(const GarmentSim* garment) const { return adaptive_.asleep(garment); }
 
  private:
   drape_context_desc desc_;
@@ -86,11 +105,35 @@ class Context {
   bool updated_ = false;
   bool shapeDirty_ = false;
 
+  // Backends: the requested choice and its OpenCL runtime (shared with contexts choosing the same
+  // device). applyBackend puts one garment where the choice says; checkDeviceFailures moves
+  // garments whose device failed back to the CPU.
+  struct Backend;
+  std::shared_ptr<Backend> backend_;
+  void applyBackend(GarmentSim& garment);
+  void checkDeviceFailures();
+
   uint32_t pushed_ = 0, accepted_ = 0, rejected_ = 0, dropped_ = 0, updates_ = 0;
   bool teleported_ = false;
   double skeletonMs_ = 0.0, bodyMs_ = 0.0, proxiesMs_ = 0.0;
   float volumeL_ = 0.0f;
   bool volumeDirty_ = true;
+
+  // Adaptive pipeline state (context_adaptive.cpp).
+  PipelineOptions options_;
+  AdaptiveState adaptive_;
+  bool meshFresh_ = true, normalsFresh_ = true;  // body mesh / normals are of the last update
+  bool proxiesComplete_ = true;                  // every ellipsoid is of the last update
+  bool reachDirty_ = false;                      // garments, sleep or options changed since the build
+  std::vector<uint8_t> fresh_, freshAtStep_;     // per ellipsoid: built for the last update / step
+  std::vector<uint8_t> garmentReach_;            // scratch: one garment's reachable ellipsoids
+  std::vector<int> reachIndices_;                // scratch
+  std::vector<float> proxyBounds_;               // ellipsoidBoundRadii of the rest proxies
+  SkipCounters skips_;                           // finalised counters (frames before the last)
+  size_t builtThisUpdate_ = 0;
+  bool clothSkippedLast_ = false;
+  void buildProxies(const SkeletonPose& pose);
+  void finishFrameCounters();
 };
 
 // Validates a context desc (ranges documented in drape.h). Returns DRAPE_OK or an error + message.

@@ -1,4 +1,5 @@
 #include "cloth/garment_sim.h"
+#include "cloth/garment_solver.h"
 
 #include "body/mesh_metrics.h"
 #include "cloth/cloth_stats.h"
@@ -24,6 +25,10 @@ constexpr float kSettleFrameS = 1.0f / 30.0f;
 constexpr float kDressStartScale = 0.6f;
 // Soft choice of skinning segment (as the OBJ fit's default): see cloth/ring_skin.h.
 constexpr float kSkinBlendM = 0.015f;
+// A pelvis rotation beyond kPoseJumpRad + kMaxSpinRadPerS * dt in one step is no human motion.
+constexpr float kPoseJumpRad = 1.0f;          // 57 degrees
+constexpr float kMaxSpinRadPerS = 12.566f;    // two turns a second
+
 
 Mat3 partialRotation(const Mat3& R, float fraction) {
   Quat q(R);
@@ -62,20 +67,7 @@ std::string validate(const GarmentSimParams& p) {
 }
 
 // The two solvers behind one face: what GarmentSim needs of either.
-struct GarmentSim::Solver {
-  virtual ~Solver() = default;
-  virtual bool setParams(const GarmentSimParams& p, std::string& err) = 0;
-  virtual bool setPins(const std::vector<Vec3>& pins, std::string& err) = 0;
-  virtual bool setMotion(EllipsoidCollider* c, const std::vector<Ellipsoid>& a,
-                         const std::vector<Ellipsoid>& b, float margin, std::string& err) = 0;
-  virtual void step(float dt, int substeps) = 0;
-  virtual bool reset(const std::vector<Vec3>& x, std::string& err) = 0;
-  virtual void transform(const Mat3& R, const Vec3& pivot, const Vec3& t, float vscale) = 0;
-  virtual const Eigen::Vector4f* x() const = 0;
-  virtual const Eigen::Vector4f* v() const = 0;
-  virtual CollisionStats collision() const = 0;
-  virtual double collideMs() const = 0;
-};
+// struct GarmentSim::Solver: cloth/garment_solver.h (shared with the OpenCL backend).
 
 namespace {
 
@@ -96,6 +88,7 @@ struct SolverOf : GarmentSim::Solver {
     s.transform(R, pivot, t, vscale);
   }
   const Eigen::Vector4f* x() const override { return s.positions(); }
+  Eigen::Vector4f* mutableX() override { return s.mutablePositions(); }
   const Eigen::Vector4f* v() const override { return s.velocities(); }
   CollisionStats collision() const override { return s.lastCollisionStats(); }
   S s;
@@ -367,13 +360,46 @@ void GarmentSim::placeOnBody(const BodyModel& body, const std::vector<Ellipsoid>
   last_.blend_frames = frames;
 }
 
-void GarmentSim::step(const BodyModel& body, const std::vector<Ellipsoid>& start,
-                      const std::vector<Ellipsoid>& end, float dt, bool teleported) {
+bool GarmentSim::poseJumped(const RingPose& pelvis, float dt) const {
+  // The pelvis ring's rotation since the last step. People spin at up to ~2 turns a second (a
+  // pirouette); kPoseJumpRad on top covers the tracker's own noise on a short frame.
+  const Mat3 R = pelvis.frame * seen_pelvis_f_.transpose();
+  const float c = std::clamp(0.5f * (R.trace() - 1.0f), -1.0f, 1.0f);
+  return std::acos(c) > kPoseJumpRad + kMaxSpinRadPerS * std::min(dt, params_.max_step_s);
+}
+
+void GarmentSim::setReachable(const std::vector<int>& indices) {
+  if (indices == reach_) return;
+  reach_.clear();
+  reach_groups_.clear();
+  for (int k : indices) {
+    if (k < 0 || static_cast<size_t>(k) >= groups_.size()) continue;  // stale index: ignored
+    reach_.push_back(k);
+    reach_groups_.push_back(groups_[static_cast<size_t>(k)]);
+  }
+  collider_.setGroups(reach_.empty() ? groups_ : reach_groups_, masks_.data());
+}
+
+const std::vector<Ellipsoid>& GarmentSim::pickReachable(const std::vector<Ellipsoid>& all,
+                                                        std::vector<Ellipsoid>& out) const {
+  if (reach_.empty()) return all;
+  out.resize(reach_.size());
+  for (size_t i = 0; i < reach_.size(); ++i) out[i] = all[static_cast<size_t>(reach_[i])];
+  return out;
+}
+
+void GarmentSim::step(const BodyModel& body, const std::vector<Ellipsoid>& start_all,
+                      const std::vector<Ellipsoid>& end_all, float dt, bool teleported) {
+  const std::vector<Ellipsoid>& start = pickReachable(start_all, reach_start_);
+  const std::vector<Ellipsoid>& end = pickReachable(end_all, reach_end_);
   const auto t0 = Clock::now();
   last_ = GarmentStepStats{};
   pins_.resize(mesh_.pinned.size());
   const RingPose& pr = body.rings()[static_cast<size_t>(pelvis_ring_)];
-  if (!tracked_) {
+  if (!tracked_ || poseJumped(pr, dt)) {
+    // First frame, or a pose no body reaches in dt from the last one (a skeleton flipped upside
+    // down for a frame): the garment is put where the body's rings carry its dressed shape.
+    last_.teleport_reset = tracked_;
     placeOnBody(body, end);
     tracked_ = true;
     runFrame(end, end, pins_, dt);
@@ -473,5 +499,30 @@ GarmentAccuracy GarmentSim::measure(const std::vector<Ellipsoid>& ellipsoids, co
   }
   return a;
 }
+
+bool GarmentSim::replaceSolver(const SolverFactory& make, std::string& err) {
+  if (kind_ != ClothSolverKind::Xpbd) {
+    err = "only the XPBD solver has another backend (the mass-spring solver runs on the CPU)";
+    return false;
+  }
+  std::unique_ptr<Solver> next = make(topology_, solver_->x(), solver_->v(), masks_, err);
+  if (!next || !next->setParams(params_, err)) return false;
+  solver_ = std::move(next);
+  return true;
+}
+
+bool GarmentSim::useCpuSolver(std::string& err) {
+  if (backend() == GarmentBackend::Cpu) return true;
+  std::unique_ptr<Solver> next = makeSolver(kind_, topology_);
+  std::vector<Vec3> x(particleCount());
+  for (size_t i = 0; i < x.size(); ++i) x[i] = solver_->x()[i].head<3>();
+  if (!next->setParams(params_, err) || !next->reset(x, err)) return false;
+  solver_ = std::move(next);
+  return true;
+}
+
+GarmentBackend GarmentSim::backend() const { return solver_->backend(); }
+
+bool GarmentSim::deviceFailed(std::string* err) const { return solver_->deviceFailed(err); }
 
 }  // namespace drape

@@ -24,6 +24,7 @@
 #include "proxies/collision.h"
 #include "proxies/mesh_bvh.h"
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -31,6 +32,8 @@
 namespace drape {
 
 enum class ClothSolverKind : int { Xpbd = 0, MassSpring = 1 };
+// Where a garment's cloth step runs (docs/opencl.md): the CPU solver or an OpenCL device.
+enum class GarmentBackend : int { Cpu = 0, OpenCl = 1 };
 
 struct GarmentSimParams {
   // Garments limit the collider's escape step to 1 cm: cloth pinched between touching body parts
@@ -128,13 +131,36 @@ class GarmentSim {
   static uint8_t maskForChain(int chain);
   static int nearestChain(const BodyModel& body, const Vec3& p);
 
+  // Proxy culling (capi/adaptive.h): the indices (increasing) of the ellipsoids the garment can
+  // reach now; step() hands the collider only those, with their groups. The others are ones no
+  // particle of this garment can touch, so the result is the same as with all of them. Empty: all.
+  void setReachable(const std::vector<int>& indices);
+  const std::vector<int>& reachable() const { return reach_; }
+  // The context skipped this garment's step (it is asleep): the last step's statistics say that
+  // nothing ran.
+  void markSkipped() { last_ = GarmentStepStats{}; }
+
   const GarmentStepStats& lastStep() const { return last_; }
   uint64_t steps() const { return steps_; }
 
   // Accuracy now against `ellipsoids` and, when `body_bvh` is non-null, the body mesh it holds.
   GarmentAccuracy measure(const std::vector<Ellipsoid>& ellipsoids, const TriangleBvh* body_bvh) const;
 
-  struct Solver;  // the solver behind the garment (defined in the .cpp)
+  struct Solver;  // the solver behind the garment (cloth/garment_solver.h)
+
+  // Backends (docs/opencl.md). A factory builds a solver from the garment's topology, its state
+  // now (particleCount() positions and velocities, xyzw) and its collision masks.
+  using SolverFactory = std::function<std::unique_ptr<Solver>(
+      const GarmentTopology&, const Eigen::Vector4f* x, const Eigen::Vector4f* v,
+      const std::vector<uint8_t>& masks, std::string& err)>;
+  // Replaces the XPBD solver by make(...)'s with the current params; false + err and nothing
+  // changed when make or setParams fails, or for the mass-spring solver (CPU only).
+  bool replaceSolver(const SolverFactory& make, std::string& err);
+  // Back to the CPU XPBD solver at the current positions (velocities restart at zero).
+  bool useCpuSolver(std::string& err);
+  GarmentBackend backend() const;
+  // Whether the solver's device failed (its last frame was not applied); the reason in *err.
+  bool deviceFailed(std::string* err) const;
 
   // Bookkeeping of the C ABI layer (its handle token and owning context); unused here.
   void* api_token = nullptr;
@@ -145,6 +171,8 @@ class GarmentSim {
   void pinTargets(const BodyModel& body, std::vector<Vec3>& out) const;
   void runFrame(const std::vector<Ellipsoid>& start, const std::vector<Ellipsoid>& end,
                 const std::vector<Vec3>& pins, float dt);
+  // The pelvis turned farther since the last step than a person can turn in dt.
+  bool poseJumped(const RingPose& pelvis, float dt) const;
   void carry(const Mat3& R, const Vec3& pivot, const Vec3& t, float velocity_scale);
   // Places the dressed garment on `body` by skinning and settles it for blend_in_s.
   void placeOnBody(const BodyModel& body, const std::vector<Ellipsoid>& ellipsoids);
@@ -172,6 +200,12 @@ class GarmentSim {
   std::vector<Vec3> pins_, scratch3_;
   std::vector<Ellipsoid> carried_start_;
   mutable std::vector<Vec3> normal_positions_, normals_;  // normals() scratch
+  // setReachable(): the reachable indices, their groups, and the step's ellipsoids picked from
+  // the full lists.
+  std::vector<int> reach_;
+  std::vector<uint8_t> reach_groups_;
+  std::vector<Ellipsoid> reach_start_, reach_end_;
+  const std::vector<Ellipsoid>& pickReachable(const std::vector<Ellipsoid>& all, std::vector<Ellipsoid>& out) const;
   GarmentStepStats last_;
   uint64_t steps_ = 0;
 };

@@ -288,6 +288,10 @@ bool XpbdSolver::setParams(const XpbdParams& p, std::string& error) {
     error = "collision_stride must be in [1, 8]";
     return false;
   }
+  if (p.iterations < 1 || p.iterations > 64) {
+    error = "iterations must be in [1, 64]";
+    return false;
+  }
   params_ = p;
   refreshCompliance();
   return true;
@@ -411,10 +415,12 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
       }
     }
   }
-  project<false>(x, distance_.a.data(), distance_.b.data(), distance_.rest.data(),
-                        distance_.inv_w.data(), distance_.a.size(), 1.0f);
-  project<true>(x, tethers_.a.data(), tethers_.b.data(), tethers_.rest.data(),
-                       tethers_.inv_w.data(), tethers_.a.size(), p.tether_scale);
+  for (int it = 0; it < p.iterations; ++it) {  // 1 by default: the method's single pass
+    project<false>(x, distance_.a.data(), distance_.b.data(), distance_.rest.data(),
+                   distance_.inv_w.data(), distance_.a.size(), 1.0f);
+    project<true>(x, tethers_.a.data(), tethers_.b.data(), tethers_.rest.data(),
+                  tethers_.inv_w.data(), tethers_.a.size(), p.tether_scale);
+  }
   // 3. Collision against the tracking ellipsoids.
   if (collider != nullptr) {
     const Clock::time_point t0 = timing_ ? Clock::now() : Clock::time_point{};

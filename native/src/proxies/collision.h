@@ -82,6 +82,8 @@ class EllipsoidCollider {
   // particle collides with every ellipsoid. Needs count() <= kMaxGridEllipsoids at collide time
   // (otherwise groups are ignored).
   void setGroups(const std::vector<uint8_t>& ellipsoid_groups, const uint8_t* particle_masks);
+  // The groups setGroups received (empty: none), for the OpenCL backend's copy of the collider.
+  const std::vector<uint8_t>& groups() const { return groups_; }
   float margin() const { return margin_; }
   // The inflated ellipsoid at the substep end (what a particle must end outside of).
   Ellipsoid inflatedEnd(int i) const;

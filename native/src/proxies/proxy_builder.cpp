@@ -62,10 +62,38 @@ void ProxyBuilder::add(const Ellipsoid& e, const ProxySource& s) {
   }
   ellipsoids_[count_].refresh();
   ++count_;
+  ++built_;
+}
+
+bool ProxyBuilder::skipNext(const ProxySource& s) {
+  if (!active_ || (*active_)[count_]) return false;
+  sources_[count_] = s;
+  ++count_;
+  return true;
+}
+
+bool ProxyBuilder::anyActive(size_t first, size_t count) const {
+  if (!active_) return true;
+  for (size_t k = first; k < first + count; ++k)
+    if ((*active_)[k]) return true;
+  return false;
 }
 
 void ProxyBuilder::build(const BodyModel& body, const SkeletonPose& pose) {
+  active_ = nullptr;
+  buildAll(body, pose);
+}
+
+void ProxyBuilder::build(const BodyModel& body, const SkeletonPose& pose, const std::vector<uint8_t>& active) {
+  // A first build sizes the arrays and records the chains' ranges: it cannot be culled.
+  active_ = ellipsoids_.empty() || active.size() != ellipsoids_.size() ? nullptr : &active;
+  buildAll(body, pose);
+  active_ = nullptr;
+}
+
+void ProxyBuilder::buildAll(const BodyModel& body, const SkeletonPose& pose) {
   count_ = 0;
+  built_ = 0;
   if (subRings_.empty()) planSubRings(body);
   const auto& rings = body.rings();
   const bool paper = rule_ == ProxyRule::Paper;
@@ -89,6 +117,7 @@ void ProxyBuilder::build(const BodyModel& body, const SkeletonPose& pose) {
           }
         }
         if (ringOnBone < 0) ringOnBone = first;
+        if (skipNext({chain, ringOnBone, k})) continue;
         Ellipsoid e;
         e.centre = 0.5f * (a + b);
         e.rotation = rings[ringOnBone].frame;
@@ -106,6 +135,7 @@ void ProxyBuilder::build(const BodyModel& body, const SkeletonPose& pose) {
     if (paper) {
       // One ellipsoid per ring (paper eq. 5): (L_l, H, L_s), H = the larger neighbour spacing.
       for (int i = 0; i < n; ++i) {
+        if (skipNext({chain, first + i, -1})) continue;
         const RingPose& r = rings[first + i];
         Ellipsoid e;
         e.centre = r.centre;
@@ -118,6 +148,12 @@ void ProxyBuilder::build(const BodyModel& body, const SkeletonPose& pose) {
     // Drape rule: ellipsoids at the rings and at sub-rings interpolated between them, so that no
     // two are further apart than kMaxSpacingOverRadius x the smaller radius; each reaches
     // kOverlap x its spacing along the chain (chain ends: 1 x, so they do not overshoot).
+    if (active_ && !anyActive(chainFirst_[c], chainCount_[c])) {
+      // Culled chain: none of its ellipsoids is wanted, so its sub-rings are not even placed.
+      for (size_t k = 0; k < chainCount_[c]; ++k) ++count_;
+      continue;
+    }
+    if (!active_) chainFirst_[c] = count_;
     int emitted = 0;
     for (int i = 0; i < n; ++i) {
       const RingPose& r = rings[first + i];
@@ -137,7 +173,9 @@ void ProxyBuilder::build(const BodyModel& body, const SkeletonPose& pose) {
         scratch_[static_cast<size_t>(emitted++)] = v;
       }
     }
+    if (!active_) chainCount_[c] = static_cast<size_t>(emitted);
     for (int i = 0; i < emitted; ++i) {
+      if (skipNext({chain, scratchRing_[static_cast<size_t>(i)], -1})) continue;
       const RingPose& v = scratch_[static_cast<size_t>(i)];
       float spacing = 0.0f;
       if (i > 0) spacing = std::max(spacing, (v.centre - scratch_[static_cast<size_t>(i - 1)].centre).norm());
@@ -170,6 +208,7 @@ void ProxyBuilder::build(const BodyModel& body, const SkeletonPose& pose) {
     const auto& positions = body.positions();
     for (int a = 0; a < 5; ++a) {
       const int last = body.chainFirstRing(ends[a]) + body.chainRingCount(ends[a]) - 1;
+      if (skipNext({ends[a], last, -1})) continue;
       const RingPose& r = rings[last];
       const Vec3& apex = positions[positions.size() - 5 + static_cast<size_t>(a)];
       const Vec3 span = apex - r.centre;

@@ -15,6 +15,7 @@
 #include "body/body_model.h"
 #include "proxies/ellipsoid.h"
 
+#include <cstdint>
 #include <vector>
 
 namespace drape {
@@ -36,12 +37,27 @@ class ProxyBuilder {
   // depend only on the rule and the body's topology, so they are stable from frame to frame.
   // No allocation after the first call.
   void build(const BodyModel& body, const SkeletonPose& pose);
+  // The same for only the ellipsoids k with active[k] != 0 (proxy culling, capi/adaptive.h): the
+  // others keep the values of the last build that included them, indices stay stable. An
+  // active ellipsoid gets exactly the value a full build gives it. The first build of a builder is
+  // always full (it sizes the arrays); active must have one entry per ellipsoid.
+  void build(const BodyModel& body, const SkeletonPose& pose, const std::vector<uint8_t>& active);
+  // Ellipsoids written by the last build (all, or the active ones).
+  size_t lastBuilt() const { return built_; }
 
   const std::vector<Ellipsoid>& ellipsoids() const { return ellipsoids_; }
   const std::vector<ProxySource>& sources() const { return sources_; }
 
  private:
   void add(const Ellipsoid& e, const ProxySource& s);
+  // Whether the next ellipsoid (index count_) is culled from this build; if so, counts it.
+  bool skipNext(const ProxySource& s);
+  bool anyActive(size_t first, size_t count) const;
+  void buildAll(const BodyModel& body, const SkeletonPose& pose);
+  const std::vector<uint8_t>* active_ = nullptr;  // during a culled build
+  size_t built_ = 0;
+  // Ellipsoid index range of each chain's ring ellipsoids (Drape rule), from the first build.
+  size_t chainFirst_[kChainCount] = {}, chainCount_[kChainCount] = {};
   void planSubRings(const BodyModel& body);
   std::vector<int> subRings_;        // per ring: sub-rings inserted before the next ring
   std::vector<RingPose> scratch_;    // one chain's rings and sub-rings

@@ -1,0 +1,76 @@
+#include "backends/opencl/cl_garment_solver.h"
+
+#include "backends/opencl/cl_xpbd_solver.h"
+#include "cloth/garment_solver.h"
+
+namespace drape {
+namespace {
+
+struct ClXpbdFace final : GarmentSim::Solver {
+  explicit ClXpbdFace(std::unique_ptr<ClXpbdSolver> solver) : s(std::move(solver)) {}
+
+  bool setParams(const GarmentSimParams& p, std::string& err) override { return s->setParams(p.xpbd, err); }
+  bool setPins(const std::vector<Vec3>& pins, std::string& err) override {
+    return s->setPinTargets(pins.data(), pins.size(), err);
+  }
+  bool setMotion(EllipsoidCollider* c, const std::vector<Ellipsoid>& a, const std::vector<Ellipsoid>& b,
+                 float margin, std::string& err) override {
+    static const std::vector<uint8_t> kNone;
+    return s->setColliderMotion(a.data(), b.data(), static_cast<int>(a.size()), margin, c ? c->groups() : kNone, err);
+  }
+  void step(float dt, int substeps) override {
+    flush();
+    // A device failure leaves the last good state; the context then moves the garment to the CPU.
+    if (!s->step(dt, substeps) && !s->lastError().empty()) {
+      failed = true;
+      error = s->lastError();
+    }
+  }
+  bool reset(const std::vector<Vec3>& x, std::string& err) override {
+    dirty = false;
+    return s->reset(x.data(), x.size(), err);
+  }
+  void transform(const Mat3& R, const Vec3& pivot, const Vec3& t, float vscale) override {
+    flush();
+    s->transform(R, pivot, t, vscale);
+  }
+  const Eigen::Vector4f* x() const override { return s->positions(); }
+  Eigen::Vector4f* mutableX() override {
+    dirty = true;  // the caller may write: the device gets the positions before the next use
+    return s->mutablePositions();
+  }
+  const Eigen::Vector4f* v() const override { return s->velocities(); }
+  CollisionStats collision() const override { return s->lastCollisionStats(); }
+  // Collision runs inside the frame kernel with the rest of the step: no separate time.
+  double collideMs() const override { return 0.0; }
+  GarmentBackend backend() const override { return GarmentBackend::OpenCl; }
+  bool deviceFailed(std::string* err) const override {
+    if (failed && err) *err = error;
+    return failed;
+  }
+
+  void flush() {
+    if (dirty && !s->pushPositions()) {
+      failed = true;
+      error = s->lastError();
+    }
+    dirty = false;
+  }
+
+  std::unique_ptr<ClXpbdSolver> s;
+  bool dirty = false, failed = false;
+  std::string error;
+};
+
+}  // namespace
+
+GarmentSim::SolverFactory clGarmentSolverFactory(std::shared_ptr<ClRuntime> runtime) {
+  return [runtime](const GarmentTopology& t, const Eigen::Vector4f* x, const Eigen::Vector4f* v,
+                   const std::vector<uint8_t>& masks, std::string& err) -> std::unique_ptr<GarmentSim::Solver> {
+    std::unique_ptr<ClXpbdSolver> s = ClXpbdSolver::create(runtime, t, masks, {}, err);
+    if (!s || !s->setState(x, v, t.particleCount(), err)) return nullptr;
+    return std::make_unique<ClXpbdFace>(std::move(s));
+  };
+}
+
+}  // namespace drape

@@ -1,0 +1,77 @@
+// OpenCL device choice and the program: platform/device enumeration, the choice (prefer a GPU,
+// or the host's indices, or the host's own cl_context + cl_command_queue), and the program
+// built once per runtime with -D sizes. A failure anywhere returns null with the reason (the
+// build log included), which the caller reports as its fallback reason. docs/opencl.md.
+#pragma once
+
+#include "backends/opencl/cl_sources.h"
+
+#include <CL/cl.h>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace drape {
+
+struct ClDeviceDesc {
+  int platform = 0, device = 0;  // indices as enumerated
+  std::string platform_name, device_name;
+  bool gpu = false;
+  uint64_t global_mem = 0, local_mem = 0;
+  unsigned compute_units = 0;
+};
+
+// Every device of every platform, in enumeration order. Empty with `err` when there is no
+// platform (no ICD installed) or enumeration fails.
+std::vector<ClDeviceDesc> listClDevices(std::string& err);
+
+struct ClChoice {
+  int platform = -1, device = -1;  // -1: choose (a GPU first when prefer_gpu, else the first)
+  bool prefer_gpu = true;
+  void* host_context = nullptr;  // cl_context and cl_command_queue of the host: both or neither
+  void* host_queue = nullptr;
+  // Internal hooks (tests): appended to the build options / the program source.
+  std::string extra_options, extra_source;
+};
+
+const char* clErrorName(cl_int code);
+
+class ClRuntime {
+ public:
+  // Null with `err` on failure (no platform or device, bad indices, context or queue creation,
+  // the program's build with its log).
+  static std::shared_ptr<ClRuntime> create(const ClChoice& choice, std::string& err);
+  ~ClRuntime();
+  ClRuntime(const ClRuntime&) = delete;
+  ClRuntime& operator=(const ClRuntime&) = delete;
+
+  cl_context context() const { return context_; }
+  cl_command_queue queue() const { return queue_; }
+  cl_device_id device() const { return device_; }
+  cl_program program() const { return program_; }
+  const std::string& deviceName() const { return device_name_; }
+  const std::string& platformName() const { return platform_name_; }
+  bool profiling() const { return profiling_; }
+  // Particles one work-group keeps in __local memory (DRAPE_CL_MAX_LOCAL_PARTICLES).
+  size_t localParticles() const { return local_particles_; }
+  size_t workGroup() const { return work_group_; }
+  double buildMs() const { return build_ms_; }
+
+ private:
+  ClRuntime() = default;
+  bool build(const ClChoice& choice, std::string& err);
+
+  cl_context context_ = nullptr;
+  cl_command_queue queue_ = nullptr;
+  cl_device_id device_ = nullptr;
+  cl_program program_ = nullptr;
+  bool owns_ = true;
+  bool profiling_ = false;
+  std::string device_name_, platform_name_;
+  size_t local_particles_ = 1, work_group_ = 64;
+  double build_ms_ = 0.0;
+};
+
+}  // namespace drape

@@ -1,0 +1,463 @@
+#include "backends/opencl/cl_xpbd_solver.h"
+
+#include "backends/opencl/cl_shapes.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace drape {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double eventNs(cl_event e) {
+  cl_ulong a = 0, b = 0;
+  if (clGetEventProfilingInfo(e, CL_PROFILING_COMMAND_START, sizeof(a), &a, nullptr) != CL_SUCCESS ||
+      clGetEventProfilingInfo(e, CL_PROFILING_COMMAND_END, sizeof(b), &b, nullptr) != CL_SUCCESS)
+    return 0.0;
+  return static_cast<double>(b - a);
+}
+
+double sumAndRelease(std::vector<cl_event>& events, bool profiling) {
+  double ns = 0.0;
+  for (cl_event e : events) {
+    if (profiling) ns += eventNs(e);
+    clReleaseEvent(e);
+  }
+  events.clear();
+  return ns;
+}
+
+void release(cl_mem& m) {
+  if (m) clReleaseMemObject(m);
+  m = nullptr;
+}
+
+// Appends the colour groups of `c` (compliance per constraint) to the device lists.
+void appendGroups(const DistanceConstraints& c, float compliance, std::vector<DrapeClConstraint>& out,
+                  std::vector<float>& comp, std::vector<uint32_t>& offsets) {
+  for (size_t g = 0; g < c.colours(); ++g) {
+    for (uint32_t k = c.colour_offsets[g]; k < c.colour_offsets[g + 1]; ++k) {
+      out.push_back(DrapeClConstraint{c.a[k], c.b[k], c.rest[k], 0.0f});
+      comp.push_back(compliance);
+    }
+    offsets.push_back(static_cast<uint32_t>(out.size()));
+  }
+}
+
+}  // namespace
+
+std::unique_ptr<ClXpbdSolver> ClXpbdSolver::create(std::shared_ptr<ClRuntime> runtime, GarmentTopology topology,
+                                                   std::vector<uint8_t> masks, std::vector<uint8_t> groups,
+                                                   std::string& err) {
+  if (!runtime) {
+    err = "no OpenCL runtime";
+    return nullptr;
+  }
+  if (!masks.empty() && masks.size() != topology.particleCount()) {
+    err = "one collision mask per particle expected";
+    return nullptr;
+  }
+  std::unique_ptr<ClXpbdSolver> s(new ClXpbdSolver());
+  s->runtime_ = std::move(runtime);
+  s->topology_ = std::move(topology);
+  s->masks_ = std::move(masks);
+  s->groups_ = std::move(groups);
+  const size_t n = s->topology_.particleCount();
+  s->x_.resize(n);
+  s->v_.assign(n, Eigen::Vector4f::Zero());
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3& p = s->topology_.rest_positions[i];
+    s->x_[i] = Eigen::Vector4f(p.x(), p.y(), p.z(), s->topology_.inverse_mass[i]);
+  }
+  s->pin_index_.assign(s->topology_.pinned.begin(), s->topology_.pinned.end());
+  s->pin_target_.resize(s->pin_index_.size());
+  for (size_t k = 0; k < s->pin_index_.size(); ++k) s->pin_target_[k] = s->topology_.rest_positions[s->pin_index_[k]];
+  s->pin_target4_.resize(s->pin_index_.size());
+  s->group_offsets_.push_back(0);
+  const GarmentTopology& t = s->topology_;
+  for (const DistanceConstraints* c : {&t.stretch, &t.shear, &t.bend})
+    appendGroups(*c, 0.0f, s->constraints_, s->compliance_, s->group_offsets_);
+  s->distance_groups_ = static_cast<uint32_t>(s->group_offsets_.size() - 1);
+  s->group_offsets_.push_back(static_cast<uint32_t>(s->constraints_.size()));
+  appendGroups(t.tether, 0.0f, s->constraints_, s->compliance_, s->group_offsets_);
+  s->tether_groups_ = static_cast<uint32_t>(s->group_offsets_.size()) - s->distance_groups_ - 2;
+  std::string perr;
+  if (!s->setParams(XpbdParams{}, perr) || !s->allocate(err)) {
+    if (err.empty()) err = perr;
+    return nullptr;
+  }
+  return s;
+}
+
+ClXpbdSolver::~ClXpbdSolver() {
+  if (frame_) clReleaseKernel(frame_);
+  if (transform_) clReleaseKernel(transform_);
+  for (cl_mem* m : {&garment_, &x_buf_, &prev_buf_, &v_buf_, &span_start_buf_, &pin_start_buf_, &pin_index_buf_,
+                    &pin_target_buf_, &constraint_buf_, &group_buf_, &mask_buf_, &shape_buf_, &bounds_buf_,
+                    &stats_buf_})
+    release(*m);
+}
+
+bool ClXpbdSolver::allocate(std::string& err) {
+  cl_context ctx = runtime_->context();
+  const size_t n = std::max<size_t>(1, particleCount());
+  const size_t pins = std::max<size_t>(1, pin_index_.size());
+  cl_int rc = CL_SUCCESS;
+  auto make = [&](cl_mem& m, size_t bytes) {
+    if (rc != CL_SUCCESS) return;
+    m = clCreateBuffer(ctx, CL_MEM_READ_WRITE, bytes, nullptr, &rc);
+  };
+  make(garment_, sizeof(DrapeClGarment));
+  make(x_buf_, n * 16);
+  make(prev_buf_, n * 16);
+  make(v_buf_, n * 16);
+  make(span_start_buf_, n * 16);
+  make(pin_start_buf_, pins * 16);
+  make(pin_index_buf_, pins * 4);
+  make(pin_target_buf_, pins * 16);
+  make(constraint_buf_, std::max<size_t>(1, constraints_.size()) * sizeof(DrapeClConstraint));
+  make(group_buf_, group_offsets_.size() * 4);
+  make(mask_buf_, n);
+  make(stats_buf_, sizeof(DrapeClStats));
+  shape_capacity_ = 64;
+  bounds_capacity_ = 16;
+  make(shape_buf_, shape_capacity_ * sizeof(DrapeClShape));
+  make(bounds_buf_, bounds_capacity_ * 16);
+  if (rc != CL_SUCCESS) {
+    err = std::string("OpenCL buffer allocation failed (") + clErrorName(rc) + ")";
+    return false;
+  }
+  frame_ = clCreateKernel(runtime_->program(), "drape_xpbd_frame", &rc);
+  if (rc == CL_SUCCESS) transform_ = clCreateKernel(runtime_->program(), "drape_transform", &rc);
+  if (rc != CL_SUCCESS) {
+    err = std::string("clCreateKernel failed (") + clErrorName(rc) + ")";
+    return false;
+  }
+  const cl_mem args[] = {garment_, x_buf_, prev_buf_, v_buf_, span_start_buf_, pin_start_buf_, pin_index_buf_,
+                         pin_target_buf_, constraint_buf_, group_buf_, mask_buf_, shape_buf_, bounds_buf_,
+                         stats_buf_};
+  for (cl_uint i = 0; i < 14 && rc == CL_SUCCESS; ++i) rc = clSetKernelArg(frame_, i, sizeof(cl_mem), &args[i]);
+  // Static data once: pin indices, group table, masks (0xFF: every group when none given).
+  std::vector<uint8_t> masks(masks_);
+  masks.resize(n, 0xFF);
+  std::vector<uint32_t> pin_index(pin_index_);
+  pin_index.resize(pins, 0);
+  cl_command_queue q = runtime_->queue();
+  if (rc == CL_SUCCESS) rc = clEnqueueWriteBuffer(q, pin_index_buf_, CL_TRUE, 0, pins * 4, pin_index.data(), 0, nullptr, nullptr);
+  if (rc == CL_SUCCESS)
+    rc = clEnqueueWriteBuffer(q, group_buf_, CL_TRUE, 0, group_offsets_.size() * 4, group_offsets_.data(), 0, nullptr, nullptr);
+  if (rc == CL_SUCCESS) rc = clEnqueueWriteBuffer(q, mask_buf_, CL_TRUE, 0, n, masks.data(), 0, nullptr, nullptr);
+  if (rc != CL_SUCCESS) {
+    err = std::string("OpenCL setup failed (") + clErrorName(rc) + ")";
+    return false;
+  }
+  if (!uploadState()) {
+    err = device_error_;
+    return false;
+  }
+  return true;
+}
+
+bool ClXpbdSolver::upload(cl_mem buffer, const void* data, size_t bytes, std::vector<cl_event>* events) {
+  if (bytes == 0) return true;
+  cl_event e = nullptr;
+  const cl_int rc = clEnqueueWriteBuffer(runtime_->queue(), buffer, events ? CL_FALSE : CL_TRUE, 0, bytes, data, 0,
+                                         nullptr, events ? &e : nullptr);
+  if (rc != CL_SUCCESS) {
+    device_error_ = std::string("clEnqueueWriteBuffer failed (") + clErrorName(rc) + ")";
+    return false;
+  }
+  if (events) events->push_back(e);
+  return true;
+}
+
+bool ClXpbdSolver::uploadState() {
+  if (particleCount() == 0) return true;
+  const size_t bytes = particleCount() * 16;
+  v_stale_ = false;
+  return upload(x_buf_, x_.data(), bytes, nullptr) && upload(v_buf_, v_.data(), bytes, nullptr);
+}
+
+bool ClXpbdSolver::pushPositions() {
+  if (particleCount() == 0) return true;
+  return upload(x_buf_, x_.data(), particleCount() * 16, nullptr);
+}
+
+bool ClXpbdSolver::setParams(const XpbdParams& p, std::string& error) {
+  XpbdSolver probe{GarmentTopology{}};  // the CPU solver's validation, message for message
+  if (!probe.setParams(p, error)) return false;
+  params_ = p;
+  const float by_kind[3] = {p.stretch_compliance, p.shear_compliance, p.bend_compliance};
+  const GarmentTopology& t = topology_;
+  size_t k = 0;
+  const DistanceConstraints* kinds[3] = {&t.stretch, &t.shear, &t.bend};
+  for (int kind = 0; kind < 3; ++kind)
+    for (size_t c = 0; c < kinds[kind]->a.size(); ++c) compliance_[k++] = by_kind[kind];
+  for (; k < compliance_.size(); ++k) compliance_[k] = p.tether_compliance;
+  inv_w_h2_ = -1.0f;  // recompute inv_w at the next step
+  return true;
+}
+
+void ClXpbdSolver::refreshInvW(float inv_h2) {
+  const size_t first_tether = group_offsets_[distance_groups_];
+  for (size_t k = 0; k < constraints_.size(); ++k) {
+    DrapeClConstraint& c = constraints_[k];
+    const float wb = k >= first_tether ? 0.0f : x_[c.b].w();
+    const float wsum = x_[c.a].w() + wb + compliance_[k] * inv_h2;
+    c.inv_w = wsum > 0.0f ? 1.0f / wsum : 0.0f;
+  }
+  inv_w_h2_ = inv_h2;
+  constraints_dirty_ = true;
+}
+
+bool ClXpbdSolver::setPinTargets(const Vec3* targets, size_t count, std::string& error) {
+  if (count != pin_target_.size() || (count > 0 && targets == nullptr)) {
+    error = "expected " + std::to_string(pin_target_.size()) + " pin targets, got " + std::to_string(count);
+    return false;
+  }
+  for (size_t k = 0; k < count; ++k) {
+    if (!isFinite(targets[k])) {
+      error = "pin target " + std::to_string(k) + " is not finite";
+      return false;
+    }
+  }
+  for (size_t k = 0; k < count; ++k) pin_target_[k] = targets[k];
+  return true;
+}
+
+bool ClXpbdSolver::setColliderMotion(const Ellipsoid* start, const Ellipsoid* end, int count, float margin_m,
+                                     const std::vector<uint8_t>& groups, std::string& error) {
+  // ColliderMotion::set's checks, so both backends reject the same input.
+  ColliderMotion probe;
+  EllipsoidCollider dummy;
+  if (!probe.set(&dummy, start, end, count, margin_m, error)) return false;
+  motion_start_.assign(start, start + count);
+  motion_end_.assign(end, end + count);
+  motion_margin_ = margin_m;
+  groups_ = groups;
+  return true;
+}
+
+void ClXpbdSolver::transform(const Mat3& R, const Vec3& pivot, const Vec3& t, float velocity_scale) {
+  const Vec3 shift = pivot + t;
+  for (size_t i = 0; i < particleCount(); ++i) x_[i].head<3>() = R * (Vec3(x_[i].head<3>()) - pivot) + shift;
+  if (!v_stale_)
+    for (size_t i = 0; i < particleCount(); ++i) v_[i].head<3>() = velocity_scale * (R * Vec3(v_[i].head<3>()));
+  for (Vec3& p : pin_target_) p = R * (p - pivot) + shift;
+  if (particleCount() == 0) return;
+  const cl_uint n = static_cast<cl_uint>(particleCount());
+  const DclF4 r0{R(0, 0), R(1, 0), R(2, 0), 0}, r1{R(0, 1), R(1, 1), R(2, 1), 0}, r2{R(0, 2), R(1, 2), R(2, 2), 0};
+  const DclF4 pv{pivot.x(), pivot.y(), pivot.z(), 0}, sv{shift.x(), shift.y(), shift.z(), 0};
+  cl_int rc = clSetKernelArg(transform_, 0, sizeof(cl_mem), &x_buf_);
+  rc |= clSetKernelArg(transform_, 1, sizeof(cl_mem), &v_buf_);
+  rc |= clSetKernelArg(transform_, 2, sizeof(cl_uint), &n);
+  rc |= clSetKernelArg(transform_, 3, 16, &r0);
+  rc |= clSetKernelArg(transform_, 4, 16, &r1);
+  rc |= clSetKernelArg(transform_, 5, 16, &r2);
+  rc |= clSetKernelArg(transform_, 6, 16, &pv);
+  rc |= clSetKernelArg(transform_, 7, 16, &sv);
+  rc |= clSetKernelArg(transform_, 8, sizeof(float), &velocity_scale);
+  const size_t wg = 64, global = (particleCount() + wg - 1) / wg * wg;
+  if (rc == CL_SUCCESS)
+    rc = clEnqueueNDRangeKernel(runtime_->queue(), transform_, 1, nullptr, &global, &wg, 0, nullptr, nullptr);
+  if (rc != CL_SUCCESS) {
+    // Keep host and device consistent: the host copy (already moved) goes to the device.
+    device_error_ = std::string("transform kernel failed (") + clErrorName(rc) + ")";
+    uploadState();
+  }
+}
+
+bool ClXpbdSolver::reset(const Vec3* positions, size_t count, std::string& error) {
+  if (count != particleCount() || positions == nullptr) {
+    error = "expected " + std::to_string(particleCount()) + " positions, got " + std::to_string(count);
+    return false;
+  }
+  for (size_t i = 0; i < count; ++i) {
+    if (!isFinite(positions[i])) {
+      error = "position " + std::to_string(i) + " is not finite";
+      return false;
+    }
+  }
+  for (size_t i = 0; i < count; ++i) {
+    x_[i].head<3>() = positions[i];
+    v_[i].setZero();
+  }
+  for (size_t k = 0; k < pin_target_.size(); ++k) pin_target_[k] = positions[pin_index_[k]];
+  if (!uploadState()) {
+    error = device_error_;
+    return false;
+  }
+  return true;
+}
+
+bool ClXpbdSolver::setState(const Eigen::Vector4f* x, const Eigen::Vector4f* v, size_t count, std::string& error) {
+  if (count != particleCount() || x == nullptr || v == nullptr) {
+    error = "expected " + std::to_string(particleCount()) + " particles";
+    return false;
+  }
+  for (size_t i = 0; i < count; ++i) {
+    if (!x[i].allFinite() || !v[i].allFinite()) {
+      error = "particle " + std::to_string(i) + " is not finite";
+      return false;
+    }
+  }
+  for (size_t i = 0; i < count; ++i) {
+    x_[i].head<3>() = x[i].head<3>();
+    v_[i] = Eigen::Vector4f(v[i].x(), v[i].y(), v[i].z(), 0.0f);
+  }
+  for (size_t k = 0; k < pin_target_.size(); ++k) pin_target_[k] = x_[pin_index_[k]].head<3>();
+  if (!uploadState()) {
+    error = device_error_;
+    return false;
+  }
+  return true;
+}
+
+const Eigen::Vector4f* ClXpbdSolver::velocities() const {
+  if (v_stale_ && particleCount() > 0) {
+    if (clEnqueueReadBuffer(runtime_->queue(), v_buf_, CL_TRUE, 0, particleCount() * 16, v_.data(), 0, nullptr,
+                            nullptr) == CL_SUCCESS)
+      v_stale_ = false;
+  }
+  return v_.data();
+}
+
+bool ClXpbdSolver::step(float dt, int substeps) {
+  if (!(dt > 0.0f) || !(dt <= 1.0f) || substeps < 1 || substeps > 1000) return false;
+  timings_ = ClStepTimings{};
+  collision_stats_ = CollisionStats{};
+  const size_t n = particleCount();
+  if (n == 0) return true;
+  const auto host0 = Clock::now();
+  const float h = dt / static_cast<float>(substeps);
+  const float inv_h2 = 1.0f / (h * h);
+  if (inv_h2 != inv_w_h2_) refreshInvW(inv_h2);
+  const int count = static_cast<int>(motion_start_.size());
+  const int stride = params_.collision_stride;
+  if (count > 0) {
+    packFrameShapes(motion_start_.data(), motion_end_.data(), count, motion_margin_, groups_, substeps, stride,
+                    shapes_, bounds_);
+  } else {
+    shapes_.clear();
+    bounds_.clear();
+  }
+  for (size_t k = 0; k < pin_target_.size(); ++k)
+    pin_target4_[k] = DclF4{pin_target_[k].x(), pin_target_[k].y(), pin_target_[k].z(), 0.0f};
+
+  const XpbdParams& p = params_;
+  DrapeClGarment g{};
+  g.hg = DclF4{h * p.gravity.x(), h * p.gravity.y(), h * p.gravity.z(), 0.0f};
+  g.wind = DclF4{p.wind.x(), p.wind.y(), p.wind.z(), 0.0f};
+  g.particle_offset = 0;
+  g.particle_count = static_cast<uint32_t>(n);
+  g.distance_group_offset = 0;
+  g.distance_groups = distance_groups_;
+  g.tether_group_offset = distance_groups_ + 1;
+  g.tether_groups = tether_groups_;
+  g.pin_offset = 0;
+  g.pin_count = static_cast<uint32_t>(pin_index_.size());
+  g.shape_offset = 0;
+  g.shape_count = static_cast<uint32_t>(count);
+  g.span_offset = 0;
+  const CollisionParams& cp = p.collision;
+  g.flags = (cp.continuous ? DRAPE_CL_CONTINUOUS : 0u) | (cp.response == ContactResponse::Exact ? DRAPE_CL_EXACT : 0u) |
+            (!masks_.empty() && groups_.size() == static_cast<size_t>(count) && count > 0 &&
+                     count <= EllipsoidCollider::kMaxGridEllipsoids
+                 ? DRAPE_CL_GROUPED
+                 : 0u) |
+            (n <= runtime_->localParticles() ? DRAPE_CL_LOCAL : 0u);
+  g.substeps = substeps;
+  g.stride = stride;
+  g.iterations = p.iterations;
+  g.h = h;
+  g.inv_n = 1.0f / static_cast<float>(substeps);
+  g.h_drag = h * p.drag;
+  g.max_speed = p.max_speed;
+  g.max_speed2 = p.max_speed > 0.0f ? p.max_speed * p.max_speed : 0.0f;
+  g.velocity_scale = std::exp(-p.damping * h) / h;
+  g.tether_scale = p.tether_scale;
+  // The collider clamps friction to [0, 1e6] (NaN -> 0).
+  g.static_friction = cp.static_friction > 0.0f ? std::min(cp.static_friction, 1e6f) : 0.0f;
+  g.kinetic_friction = cp.kinetic_friction > 0.0f ? std::min(cp.kinetic_friction, 1e6f) : 0.0f;
+  g.max_escape = cp.max_escape_m;
+  timings_.host_ns = std::chrono::duration<double, std::nano>(Clock::now() - host0).count();
+
+  // Grow the shape buffers (rare: more substeps or ellipsoids than before).
+  cl_int rc = CL_SUCCESS;
+  if (shapes_.size() > shape_capacity_) {
+    release(shape_buf_);
+    shape_capacity_ = shapes_.size() * 2;
+    shape_buf_ = clCreateBuffer(runtime_->context(), CL_MEM_READ_ONLY, shape_capacity_ * sizeof(DrapeClShape), nullptr, &rc);
+    if (rc == CL_SUCCESS) rc = clSetKernelArg(frame_, 11, sizeof(cl_mem), &shape_buf_);
+  }
+  if (rc == CL_SUCCESS && bounds_.size() > bounds_capacity_) {
+    release(bounds_buf_);
+    bounds_capacity_ = bounds_.size() * 2;
+    bounds_buf_ = clCreateBuffer(runtime_->context(), CL_MEM_READ_ONLY, bounds_capacity_ * 16, nullptr, &rc);
+    if (rc == CL_SUCCESS) rc = clSetKernelArg(frame_, 12, sizeof(cl_mem), &bounds_buf_);
+  }
+  if (rc != CL_SUCCESS) {
+    device_error_ = std::string("OpenCL shape buffer failed (") + clErrorName(rc) + ")";
+    return false;
+  }
+  std::vector<cl_event> writes, runs, reads;
+  const auto wall0 = Clock::now();
+  bool ok = upload(garment_, &g, sizeof(g), &writes) &&
+            upload(pin_target_buf_, pin_target4_.data(), pin_target4_.size() * 16, &writes) &&
+            upload(shape_buf_, shapes_.data(), shapes_.size() * sizeof(DrapeClShape), &writes) &&
+            upload(bounds_buf_, bounds_.data(), bounds_.size() * 16, &writes);
+  if (ok && constraints_dirty_ && !constraints_.empty()) {
+    ok = upload(constraint_buf_, constraints_.data(), constraints_.size() * sizeof(DrapeClConstraint), &writes);
+    constraints_dirty_ = !ok;
+  }
+  if (ok) {
+    const size_t wg = runtime_->workGroup();
+    cl_event e = nullptr;
+    rc = clEnqueueNDRangeKernel(runtime_->queue(), frame_, 1, nullptr, &wg, &wg, 0, nullptr, &e);
+    if (rc == CL_SUCCESS) {
+      runs.push_back(e);
+    } else {
+      device_error_ = std::string("clEnqueueNDRangeKernel failed (") + clErrorName(rc) + ")";
+      ok = false;
+    }
+  }
+  DrapeClStats stats{};
+  std::vector<Eigen::Vector4f> x_back;
+  if (ok) {
+    x_back.resize(n);
+    cl_event e1 = nullptr, e2 = nullptr;
+    rc = clEnqueueReadBuffer(runtime_->queue(), stats_buf_, CL_FALSE, 0, sizeof(stats), &stats, 0, nullptr, &e1);
+    if (rc == CL_SUCCESS) {
+      reads.push_back(e1);
+      rc = clEnqueueReadBuffer(runtime_->queue(), x_buf_, CL_TRUE, 0, n * 16, x_back.data(), 0, nullptr, &e2);
+      if (rc == CL_SUCCESS) reads.push_back(e2);
+    }
+    if (rc == CL_SUCCESS) rc = clFinish(runtime_->queue());
+    if (rc != CL_SUCCESS) {
+      device_error_ = std::string("OpenCL frame failed (") + clErrorName(rc) + ")";
+      ok = false;
+    }
+  }
+  const double wall = std::chrono::duration<double, std::nano>(Clock::now() - wall0).count();
+  const bool prof = runtime_->profiling();
+  timings_.upload_ns = sumAndRelease(writes, prof);
+  timings_.kernel_ns = sumAndRelease(runs, prof);
+  timings_.readback_ns = sumAndRelease(reads, prof);
+  if (!prof) timings_.kernel_ns = wall;
+  if (!ok) {
+    clFinish(runtime_->queue());
+    uploadState();  // the device state may be half-stepped: restore the last good one
+    return false;
+  }
+  x_.swap(x_back);
+  v_stale_ = true;
+  collision_stats_.tests = stats.tests;
+  collision_stats_.contacts = stats.contacts;
+  collision_stats_.swept_catches = stats.swept_catches;
+  collision_stats_.escapes = stats.escapes;
+  return true;
+}
+
+}  // namespace drape

@@ -1,0 +1,110 @@
+// The XPBD cloth step on an OpenCL device: XpbdSolver (cloth/xpbd_solver.h) with the same
+// parameters, pins, colliders and answers (within float rounding: docs/opencl.md states the
+// tolerance), the whole frame in one launch. Per frame: one upload of the frame's pin targets
+// and collision shapes (every span's interpolated ellipsoids) plus the step's scalars, one kernel
+// launch running every substep (one work-group, particles in __local memory when they fit,
+// barriers between colour groups), one readback of the positions and the collision counters.
+// Velocities and the previous positions stay on the device; velocities() reads them on demand.
+#pragma once
+
+#include "backends/opencl/cl_runtime.h"
+#include "cloth/xpbd_solver.h"
+#include "drape_cl_types.h"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace drape {
+
+// Per-frame split of the last step (device profiling when the queue has it, else wall clock).
+struct ClStepTimings {
+  double upload_ns = 0.0;    // host -> device writes (shapes, pins, the garment record)
+  double kernel_ns = 0.0;    // the frame kernel (every substep)
+  double readback_ns = 0.0;  // positions + counters back to the host
+  double host_ns = 0.0;      // host work: shape interpolation and packing
+};
+
+class ClXpbdSolver {
+ public:
+  // Null + err when the device cannot hold the garment (allocation fails). masks: one byte per
+  // particle (collision groups) or empty; groups: bit per ellipsoid, or empty (see
+  // EllipsoidCollider::setGroups). The state starts at the topology's rest positions, at rest.
+  static std::unique_ptr<ClXpbdSolver> create(std::shared_ptr<ClRuntime> runtime, GarmentTopology topology,
+                                              std::vector<uint8_t> masks, std::vector<uint8_t> groups,
+                                              std::string& err);
+  ~ClXpbdSolver();
+  ClXpbdSolver(const ClXpbdSolver&) = delete;
+  ClXpbdSolver& operator=(const ClXpbdSolver&) = delete;
+
+  // As XpbdSolver.
+  bool setParams(const XpbdParams& params, std::string& error);
+  const XpbdParams& params() const { return params_; }
+  bool setPinTargets(const Vec3* targets, size_t count, std::string& error);
+  // groups: the collider's ellipsoid groups for these ellipsoids (EllipsoidCollider::groups()),
+  // applied with the particle masks given at creation; empty: every particle meets every one.
+  bool setColliderMotion(const Ellipsoid* start, const Ellipsoid* end, int count, float margin_m,
+                         const std::vector<uint8_t>& groups, std::string& error);
+  void transform(const Mat3& R, const Vec3& pivot, const Vec3& t, float velocity_scale);
+  bool reset(const Vec3* positions, size_t count, std::string& error);
+  // Positions and velocities (xyzw, as XpbdSolver) in one go: moving a running garment over.
+  bool setState(const Eigen::Vector4f* x, const Eigen::Vector4f* v, size_t count, std::string& error);
+  // False (state unchanged) on bad arguments, or when the device fails (err() says why; the
+  // state is then the last good one).
+  bool step(float dt, int substeps = XpbdSolver::kDefaultSubsteps);
+
+  size_t particleCount() const { return topology_.particleCount(); }
+  const GarmentTopology& topology() const { return topology_; }
+  const Eigen::Vector4f* positions() const { return x_.data(); }
+  // Writable xyz between steps (keep w); pushPositions() then sends them to the device.
+  Eigen::Vector4f* mutablePositions() { return x_.data(); }
+  bool pushPositions();
+  const Eigen::Vector4f* velocities() const;  // read from the device on demand
+  const CollisionStats& lastCollisionStats() const { return collision_stats_; }
+  const ClStepTimings& lastTimings() const { return timings_; }
+  const std::string& lastError() const { return device_error_; }
+  bool usesLocalMemory() const { return particleCount() <= runtime_->localParticles(); }
+  const ClRuntime& runtime() const { return *runtime_; }
+
+ private:
+  ClXpbdSolver() = default;
+  bool allocate(std::string& err);
+  bool upload(cl_mem buffer, const void* data, size_t bytes, std::vector<cl_event>* events);
+  bool uploadState();  // x_, v_ (and prev) to the device
+  void refreshInvW(float inv_h2);
+
+  std::shared_ptr<ClRuntime> runtime_;
+  GarmentTopology topology_;
+  XpbdParams params_;
+  std::vector<uint8_t> masks_, groups_;
+  std::vector<DrapeClConstraint> constraints_;  // distance groups then tether groups
+  std::vector<float> compliance_;                // per constraint
+  std::vector<uint32_t> group_offsets_;          // distance groups + 1, then tether groups + 1
+  uint32_t distance_groups_ = 0, tether_groups_ = 0;
+  float inv_w_h2_ = -1.0f;
+  bool constraints_dirty_ = true;
+
+  std::vector<Eigen::Vector4f> x_;
+  mutable std::vector<Eigen::Vector4f> v_;
+  mutable bool v_stale_ = false;
+  std::vector<Vec3> pin_target_;
+  std::vector<uint32_t> pin_index_;
+  std::vector<DclF4> pin_target4_;
+  std::vector<Ellipsoid> motion_start_, motion_end_;
+  float motion_margin_ = 0.0f;
+  std::vector<DrapeClShape> shapes_;
+  std::vector<DclF4> bounds_;
+
+  cl_kernel frame_ = nullptr, transform_ = nullptr;
+  cl_mem garment_ = nullptr, x_buf_ = nullptr, prev_buf_ = nullptr, v_buf_ = nullptr,
+         span_start_buf_ = nullptr, pin_start_buf_ = nullptr, pin_index_buf_ = nullptr,
+         pin_target_buf_ = nullptr, constraint_buf_ = nullptr, group_buf_ = nullptr,
+         mask_buf_ = nullptr, shape_buf_ = nullptr, bounds_buf_ = nullptr, stats_buf_ = nullptr;
+  size_t shape_capacity_ = 0, bounds_capacity_ = 0;
+
+  CollisionStats collision_stats_;
+  ClStepTimings timings_;
+  std::string device_error_;
+};
+
+}  // namespace drape

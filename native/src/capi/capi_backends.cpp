@@ -1,0 +1,107 @@
+// C entry points of the Backends section of drape.h (docs/opencl.md).
+#include "capi/api_support.h"
+#include "capi/context.h"
+
+#if DRAPE_HAVE_OPENCL
+#include "backends/opencl/cl_runtime.h"
+#endif
+
+#include <cstring>
+#include <string>
+
+using drape::Context;
+using drape::api::checkStructSize;
+using drape::api::fail;
+using drape::api::guarded;
+
+static_assert(sizeof(drape_backend_desc) == 24 + 2 * sizeof(void*), "drape_backend_desc layout");
+static_assert(sizeof(drape_backend_info) == 24 + 128 + 128 + 512, "drape_backend_info layout");
+static_assert(sizeof(drape_opencl_device) == 40 + 256, "drape_opencl_device layout");
+
+DRAPE_API drape_result DRAPE_CALL drape_backend_desc_init(drape_backend_desc* desc) {
+  if (!desc) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_backend_desc_init: desc is NULL");
+  std::memset(desc, 0, sizeof(*desc));
+  desc->struct_size = sizeof(drape_backend_desc);
+  desc->backend = DRAPE_BACKEND_CPU;
+  desc->platform_index = -1;
+  desc->device_index = -1;
+  desc->prefer_gpu = 1;
+  desc->opencl_min_particles = 2000;
+  return DRAPE_OK;
+}
+
+DRAPE_API drape_result DRAPE_CALL drape_context_set_backend(drape_context* context, const drape_backend_desc* desc) {
+  return guarded("drape_context_set_backend", [&]() -> drape_result {
+    DRAPE_RESOLVE_CONTEXT(ctx, "drape_context_set_backend", context);
+    if (!desc) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_set_backend: desc is NULL");
+    if (drape_result r = checkStructSize(desc->struct_size, sizeof(drape_backend_desc), "drape_backend_desc")) return r;
+    const drape_backend_desc& d = *desc;
+    if (d.backend != DRAPE_BACKEND_CPU && d.backend != DRAPE_BACKEND_OPENCL && d.backend != DRAPE_BACKEND_AUTO)
+      return fail(DRAPE_ERROR_OUT_OF_RANGE, "drape_context_set_backend: backend = " + std::to_string(d.backend) +
+                                                " is not DRAPE_BACKEND_CPU (0), _OPENCL (1) or _AUTO (2)");
+    if (d.platform_index < -1 || d.platform_index > 255 || d.device_index < -1 || d.device_index > 255)
+      return fail(DRAPE_ERROR_OUT_OF_RANGE, "drape_context_set_backend: platform_index and device_index must be in [-1, 255]");
+    if (d.prefer_gpu > 1) return fail(DRAPE_ERROR_OUT_OF_RANGE, "drape_context_set_backend: prefer_gpu must be 0 or 1");
+    if (d.opencl_min_particles > 100000000u)
+      return fail(DRAPE_ERROR_OUT_OF_RANGE, "drape_context_set_backend: opencl_min_particles must be at most 1e8");
+    if ((d.host_cl_context == nullptr) != (d.host_cl_queue == nullptr))
+      return fail(DRAPE_ERROR_INVALID_ARGUMENT,
+                  "drape_context_set_backend: host_cl_context and host_cl_queue must be given together");
+    std::string err;
+    if (drape_result r = ctx->setBackend(d, err)) return fail(r, "drape_context_set_backend: " + err);
+    return DRAPE_OK;
+  });
+}
+
+DRAPE_API drape_result DRAPE_CALL drape_context_get_backend_info(drape_context* context, drape_backend_info* out) {
+  return guarded("drape_context_get_backend_info", [&]() -> drape_result {
+    DRAPE_RESOLVE_CONTEXT(ctx, "drape_context_get_backend_info", context);
+    if (!out) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_get_backend_info: out_info is NULL");
+    if (drape_result r = checkStructSize(out->struct_size, sizeof(drape_backend_info), "drape_backend_info")) return r;
+    ctx->backendInfo(*out);
+    return DRAPE_OK;
+  });
+}
+
+DRAPE_API drape_result DRAPE_CALL drape_opencl_device_count(uint32_t* out_count) {
+  return guarded("drape_opencl_device_count", [&]() -> drape_result {
+    if (!out_count) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_opencl_device_count: out_count is NULL");
+#if DRAPE_HAVE_OPENCL
+    std::string err;
+    *out_count = static_cast<uint32_t>(drape::listClDevices(err).size());
+#else
+    *out_count = 0;
+#endif
+    return DRAPE_OK;
+  });
+}
+
+DRAPE_API drape_result DRAPE_CALL drape_opencl_device_get(uint32_t index, drape_opencl_device* out) {
+  return guarded("drape_opencl_device_get", [&]() -> drape_result {
+    if (!out) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_opencl_device_get: out_device is NULL");
+    if (drape_result r = checkStructSize(out->struct_size, sizeof(drape_opencl_device), "drape_opencl_device")) return r;
+#if DRAPE_HAVE_OPENCL
+    std::string err;
+    const auto devices = drape::listClDevices(err);
+    if (index >= devices.size())
+      return fail(DRAPE_ERROR_OUT_OF_RANGE, "drape_opencl_device_get: index " + std::to_string(index) + " >= " +
+                                                std::to_string(devices.size()) + " device(s)");
+    const drape::ClDeviceDesc& d = devices[index];
+    drape_opencl_device o;
+    std::memset(&o, 0, sizeof(o));
+    o.struct_size = sizeof(o);
+    o.platform_index = d.platform;
+    o.device_index = d.device;
+    o.is_gpu = d.gpu ? 1 : 0;
+    o.global_mem_bytes = d.global_mem;
+    o.local_mem_bytes = d.local_mem;
+    o.compute_units = d.compute_units;
+    std::strncpy(o.platform_name, d.platform_name.c_str(), sizeof(o.platform_name) - 1);
+    std::strncpy(o.device_name, d.device_name.c_str(), sizeof(o.device_name) - 1);
+    *out = o;
+    return DRAPE_OK;
+#else
+    return fail(DRAPE_ERROR_OUT_OF_RANGE, "drape_opencl_device_get: this build has no OpenCL backend (0 devices)");
+#endif
+  });
+}

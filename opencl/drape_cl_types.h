@@ -1,0 +1,80 @@
+/* Structs shared by the host (C++, native/src/backends/opencl) and the kernels (OpenCL C 1.2).
+ * Only 16-byte vectors (float4) and 4-byte scalars, in an order that needs no padding, so both
+ * compilers lay them out identically (the host static_asserts the sizes): float3 is 16 bytes in
+ * OpenCL and 12 in C++, so it never appears in a buffer. Each struct mirrors a CPU structure:
+ * DrapeClShape = EllipsoidCollider's Shape + Quick (proxies/collision.h) for one collision span,
+ * DrapeClGarment = one garment's slice of the batched buffers and its XpbdParams. */
+#ifndef DRAPE_CL_TYPES_H
+#define DRAPE_CL_TYPES_H
+
+#ifdef __OPENCL_C_VERSION__
+/* No fused multiply-adds: the CPU build (x86-64 without -mfma) rounds every product, and the
+ * parity with it is closer when the device does too. */
+#pragma OPENCL FP_CONTRACT OFF
+typedef float4 dcl_f4;
+typedef uint dcl_u32;
+typedef int dcl_i32;
+#else
+#include <cstdint>
+namespace drape {
+struct alignas(16) DclF4 {
+  float x, y, z, w;
+};
+}  // namespace drape
+typedef drape::DclF4 dcl_f4;
+typedef uint32_t dcl_u32;
+typedef int32_t dcl_i32;
+#endif
+
+/* One ellipsoid of one collision span, inflated by the margin. Matrices are stored by column
+ * (w = 0): q = to_unit * (p - centre), p = centre + from_unit * q, rot = the end rotation. */
+typedef struct {
+  dcl_f4 end_c, end_u0, end_u1, end_u2;        /* end centre, columns of S^-1 R^T */
+  dcl_f4 end_f0, end_f1, end_f2;               /* columns of R S (end) */
+  dcl_f4 start_c, start_u0, start_u1, start_u2;
+  dcl_f4 start_f0, start_f1, start_f2;
+  dcl_f4 rot0, rot1, rot2;                     /* end rotation columns */
+  dcl_f4 radii;                                /* inflated end radii */
+  dcl_f4 radii2;                               /* their squares */
+  dcl_f4 swept_min, swept_max, end_min, end_max;
+  float inside_tol2, graze;
+  dcl_i32 smallest_axis;
+  dcl_u32 group;                               /* collision-group bit(s); 0xFF without groups */
+} DrapeClShape;
+
+/* Flags of DrapeClGarment.flags. */
+#define DRAPE_CL_CONTINUOUS 1u  /* swept test */
+#define DRAPE_CL_EXACT 2u       /* exact closest point (else radial) */
+#define DRAPE_CL_GROUPED 4u     /* per-particle masks against DrapeClShape.group */
+#define DRAPE_CL_LOCAL 8u       /* particles fit in __local memory */
+
+/* One garment in a batched launch: offsets into the shared buffers and this frame's step. */
+typedef struct {
+  dcl_f4 hg;                  /* h * gravity, w = 0 */
+  dcl_f4 wind;                /* w = 0 */
+  dcl_u32 particle_offset, particle_count;
+  dcl_u32 distance_group_offset, distance_groups;  /* into the group table (constraint offsets) */
+  dcl_u32 tether_group_offset, tether_groups;
+  dcl_u32 pin_offset, pin_count;
+  dcl_u32 shape_offset, shape_count;               /* this frame: spans x shape_count shapes */
+  dcl_u32 span_offset, flags;                      /* span bounds: 2 float4 per span */
+  dcl_i32 substeps, stride;
+  dcl_i32 iterations, reserved;                    /* constraint passes per substep (>= 1) */
+  float h, inv_n, h_drag, max_speed;
+  float max_speed2, velocity_scale, tether_scale, static_friction;
+  float kinetic_friction, max_escape, pad0, pad1;
+} DrapeClGarment;
+
+/* A distance or tether constraint: a and b are particle indices within the garment;
+ * inv_w = 1 / (w_a + w_b + compliance / h^2) for the frame's h (0 = inert). */
+typedef struct {
+  dcl_u32 a, b;
+  float rest, inv_w;
+} DrapeClConstraint;
+
+/* Collision counters of one garment for the last frame (CollisionStats). */
+typedef struct {
+  dcl_u32 tests, contacts, swept_catches, escapes;
+} DrapeClStats;
+
+#endif /* DRAPE_CL_TYPES_H */

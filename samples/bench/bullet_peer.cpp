@@ -1,0 +1,255 @@
+// Built only when CMake finds Bullet (samples/CMakeLists.txt); bullet_absent.cpp otherwise.
+#include "bullet_peer.h"
+
+#include "metrics.h"
+
+#include <BulletSoftBody/btSoftBodyHelpers.h>
+#include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
+#include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
+#include <btBulletDynamicsCommon.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+
+namespace bench {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct ContextDeleter {
+  void operator()(drape_context* c) const { drape_context_destroy(c); }
+};
+
+btVector3 bt(const drape_vec3& v) { return btVector3(v.x, v.y, v.z); }
+
+btTransform pose(const drape_ellipsoid& e) {
+  const btMatrix3x3 r(e.axis_x.x, e.axis_y.x, e.axis_z.x,  //
+                      e.axis_x.y, e.axis_y.y, e.axis_z.y,  //
+                      e.axis_x.z, e.axis_y.z, e.axis_z.z);
+  return btTransform(r, bt(e.centre));
+}
+
+// Bullet's world, owned in the order it must be torn down.
+struct World {
+  btSoftBodyRigidBodyCollisionConfiguration config;
+  btCollisionDispatcher dispatcher{&config};
+  btDbvtBroadphase broadphase;
+  btSequentialImpulseConstraintSolver solver;
+  btSoftRigidDynamicsWorld world{&dispatcher, &broadphase, &solver, &config};
+  std::vector<std::unique_ptr<btMultiSphereShape>> shapes;
+  std::vector<std::unique_ptr<btRigidBody>> bodies;
+  std::unique_ptr<btSoftBody> cloth;
+  ~World() {
+    if (cloth) world.removeSoftBody(cloth.get());
+    for (auto& b : bodies) world.removeRigidBody(b.get());
+  }
+};
+
+void finish(PeerSide& side, const StretchMeter& st, const PenetrationMeter& pen, const std::vector<double>& inside) {
+  side.stretch_p99 = st.p99();
+  side.stretch_max = st.max();
+  side.penetration_p99_mm = pen.p99Mm();
+  side.penetration_max_mm = pen.maxMm();
+  side.deeper_than_2mm = pen.deeperThan2mmFraction();
+  side.inside_mean = mean(inside);
+}
+
+}  // namespace
+
+bool bulletAvailable() { return true; }
+
+bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, int iterations, PeerResult& out,
+                   std::string& error) {
+  out = PeerResult{};
+  out.substeps_per_60hz = substeps_per_60hz;
+  out.iterations = iterations;
+  out.label = std::to_string(substeps_per_60hz) + " x " + std::to_string(iterations);
+  out.take = take.name;
+  out.rate_hz = take.rate_hz;
+
+  // The driver: Drape at its default setting.
+  drape_context* raw = nullptr;
+  if (drape_result r = drape_context_create(nullptr, &raw)) return error = libraryError("drape_context_create", r), false;
+  std::unique_ptr<drape_context, ContextDeleter> ctx(raw);
+  drape_garment_template tmpl;
+  drape_garment_template_init(&tmpl);
+  tmpl.particles = particles;
+  drape_garment* garment = nullptr;
+  if (drape_result r = drape_context_add_garment_template(ctx.get(), nullptr, &tmpl, nullptr, &garment))
+    return error = libraryError("drape_context_add_garment_template", r), false;
+  drape_cloth_params cloth;
+  drape_cloth_params_init(&cloth);
+  drape_garment_get_params(garment, &cloth);
+  uint32_t nv = 0, ni = 0, ne = 0, body_nv = 0, body_ni = 0;
+  drape_garment_get_mesh_size(garment, &nv, &ni);
+  drape_context_get_ellipsoid_count(ctx.get(), &ne);
+  drape_context_get_body_mesh_size(ctx.get(), &body_nv, &body_ni);
+  out.particles = nv;
+  std::vector<uint32_t> indices(ni), body_idx(body_ni);
+  std::vector<drape_vec3> rest(nv), x(nv), body(body_nv), bx(nv);
+  drape_garment_read_mesh(garment, nullptr, nullptr, 0, indices.data(), ni);
+  drape_garment_read_rest_positions(garment, rest.data(), nv);
+  drape_context_read_body_mesh(ctx.get(), nullptr, nullptr, 0, body_idx.data(), body_ni);
+  std::vector<drape_ellipsoid> e_start(ne), e_end(ne);
+
+  auto pushStep = [&](size_t i, double& frame_ms, double& cloth_ms) -> bool {
+    drape_skeleton_frame f{};
+    f.struct_size = sizeof f;
+    f.layout = take.layout;
+    f.joint_count = take.joint_count;
+    f.timestamp_s = take.timestamps_s[i];
+    f.joints = take.frames[i].data();
+    const double dt = i == 0 ? 1.0 / take.rate_hz : take.timestamps_s[i] - take.timestamps_s[i - 1];
+    const Clock::time_point t0 = Clock::now();
+    if (drape_result r = drape_context_push_skeleton(ctx.get(), &f)) return error = libraryError("push", r), false;
+    if (drape_result r = drape_context_step(ctx.get(), static_cast<float>(std::min(std::max(dt, 1e-4), 1.0))))
+      return error = libraryError("drape_context_step", r), false;
+    frame_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    drape_garment_stats gs{};
+    gs.struct_size = sizeof gs;
+    drape_garment_get_stats(garment, &gs);
+    cloth_ms = gs.step_ms;
+    uint32_t count = 0;
+    drape_context_read_ellipsoids(ctx.get(), e_end.data(), ne, &count);
+    drape_garment_read_mesh(garment, x.data(), nullptr, nv, nullptr, 0);
+    drape_context_read_body_mesh(ctx.get(), body.data(), nullptr, body_nv, nullptr, 0);
+    return true;
+  };
+  double frame_ms = 0, cloth_ms = 0;
+  if (!pushStep(0, frame_ms, cloth_ms)) return false;
+  std::vector<uint8_t> pinned(nv, 0);
+  {
+    const float* xyzw = nullptr;
+    uint32_t n = 0;
+    drape_garment_view_positions(garment, &xyzw, &n);
+    for (uint32_t k = 0; k < n && k < nv; ++k) pinned[k] = xyzw[4 * k + 3] == 0.0f;
+  }
+
+  // Bullet: the same mesh, mass, body and attachments.
+  World w;
+  btSoftBodyWorldInfo& info = w.world.getWorldInfo();
+  info.m_gravity = bt(cloth.gravity);
+  info.air_density = 0;
+  info.water_density = 0;
+  info.m_sparsesdf.Initialize();
+  w.world.setGravity(info.m_gravity);
+  std::vector<btScalar> xyz;
+  for (const drape_vec3& p : rest) xyz.insert(xyz.end(), {p.x, p.y, p.z});
+  std::vector<int> tris(indices.begin(), indices.end());
+  w.cloth.reset(btSoftBodyHelpers::CreateFromTriMesh(info, xyz.data(), tris.data(), static_cast<int>(ni / 3), false));
+  btSoftBody& sb = *w.cloth;
+  btSoftBody::Material* mat = sb.m_materials[0];
+  mat->m_kLST = 1.0;  // stiffest links: Drape's stretch is rigid (compliance 0)
+  mat->m_kAST = 1.0;
+  sb.generateBendingConstraints(2, mat);
+  double area = 0.0;
+  for (size_t t = 0; t + 2 < indices.size(); t += 3) {
+    const btVector3 a = bt(rest[indices[t]]), b = bt(rest[indices[t + 1]]), c = bt(rest[indices[t + 2]]);
+    area += 0.5 * (b - a).cross(c - a).length();
+  }
+  sb.setTotalMass(static_cast<btScalar>(0.2 * area), true);  // drape_garment_desc_init: 0.2 kg/m^2
+  const double rate = 60.0 * substeps_per_60hz;
+  sb.m_cfg.piterations = iterations;
+  sb.m_cfg.kDP = static_cast<btScalar>(cloth.damping / rate);  // Drape's 1/s damping per substep
+  sb.m_cfg.kDF = cloth.kinetic_friction;
+  sb.m_cfg.kCHR = 1.0;
+  sb.m_cfg.collisions = btSoftBody::fCollision::SDF_RS;
+  sb.getCollisionShape()->setMargin(cloth.collision_margin_m);
+  for (uint32_t k = 0; k < nv; ++k) {
+    if (pinned[k]) sb.setMass(static_cast<int>(k), 0);
+    sb.m_nodes[static_cast<int>(k)].m_x = bt(x[k]);  // start where Drape placed it on the first pose
+    sb.m_nodes[static_cast<int>(k)].m_q = bt(x[k]);
+  }
+  w.world.addSoftBody(&sb);
+  for (uint32_t k = 0; k < ne; ++k) {
+    const btVector3 centre(0, 0, 0);
+    const btScalar radius = 1;
+    auto shape = std::make_unique<btMultiSphereShape>(&centre, &radius, 1);
+    shape->setLocalScaling(bt(e_end[k].radii));
+    btRigidBody::btRigidBodyConstructionInfo ci(0, nullptr, shape.get());
+    ci.m_startWorldTransform = pose(e_end[k]);
+    ci.m_friction = cloth.kinetic_friction;
+    auto body_rb = std::make_unique<btRigidBody>(ci);
+    body_rb->setCollisionFlags(body_rb->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
+    body_rb->setActivationState(DISABLE_DEACTIVATION);
+    w.world.addRigidBody(body_rb.get());
+    w.shapes.push_back(std::move(shape));
+    w.bodies.push_back(std::move(body_rb));
+  }
+
+  StretchMeter st_b, st_d;
+  st_b.setMesh(indices, rest);
+  st_d.setMesh(indices, rest);
+  PenetrationMeter pen_b, pen_d;
+  std::vector<double> in_b, in_d;
+  std::vector<drape_vec3> pin_start(nv);
+  for (size_t i = 1; i < take.frames.size(); ++i) {
+    e_start = e_end;
+    for (uint32_t k = 0; k < nv; ++k)
+      if (pinned[k]) pin_start[k] = x[k];
+    if (!pushStep(i, frame_ms, cloth_ms)) return false;
+    out.drape.ms.push_back(cloth_ms);
+    out.drape.frame_ms.push_back(frame_ms);
+    const double dt = take.timestamps_s[i] - take.timestamps_s[i - 1];
+    const int n = std::max(1, static_cast<int>(std::lround(dt * rate)));
+    const btScalar h = static_cast<btScalar>(dt / n);
+    // Radii follow the body each frame; Bullet's distance-field cache does not notice a new
+    // scaling, so it is cleared when any radius moved by more than 0.1 mm.
+    bool rescaled = false;
+    for (uint32_t k = 0; k < ne; ++k) {
+      const btVector3 r = bt(e_end[k].radii);
+      if ((r - w.shapes[k]->getLocalScaling()).length() > 1e-4) {
+        w.shapes[k]->setLocalScaling(r);
+        rescaled = true;
+      }
+    }
+    const Clock::time_point t0 = Clock::now();
+    if (rescaled) info.m_sparsesdf.Reset();
+    for (int s = 0; s < n; ++s) {
+      const btScalar t = static_cast<btScalar>(s + 1) / static_cast<btScalar>(n);
+      for (uint32_t k = 0; k < ne; ++k) {
+        const btTransform a = pose(e_start[k]), b = pose(e_end[k]);
+        btTransform now;
+        now.setOrigin(a.getOrigin().lerp(b.getOrigin(), t));
+        now.setRotation(a.getRotation().slerp(b.getRotation(), t));
+        btRigidBody& rb = *w.bodies[k];
+        rb.setLinearVelocity((b.getOrigin() - a.getOrigin()) / static_cast<btScalar>(dt));
+        rb.setWorldTransform(now);
+        rb.setInterpolationWorldTransform(now);
+      }
+      for (uint32_t k = 0; k < nv; ++k) {
+        if (!pinned[k]) continue;
+        btSoftBody::Node& node = sb.m_nodes[static_cast<int>(k)];
+        const btVector3 target = bt(pin_start[k]).lerp(bt(x[k]), t);
+        node.m_v = (target - node.m_x) / h;
+      }
+      w.world.stepSimulation(h, 0, h);
+    }
+    out.bullet.ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+    for (uint32_t k = 0; k < nv; ++k) {
+      const btVector3& p = sb.m_nodes[static_cast<int>(k)].m_x;
+      bx[k] = drape_vec3{static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
+      if (!std::isfinite(bx[k].x) || !std::isfinite(bx[k].y) || !std::isfinite(bx[k].z)) out.bullet.finite = false;
+    }
+    if (!pen_b.setBody(body, body_idx) || !pen_d.setBody(body, body_idx)) {
+      error = "the body mesh could not be measured";
+      return false;
+    }
+    if (out.bullet.finite) {
+      pen_b.addFrame(bx.data(), nv);
+      st_b.addFrame(bx.data());
+      in_b.push_back(countInsideEllipsoids(bx.data(), nv, pinned, e_end));
+    }
+    pen_d.addFrame(x.data(), nv);
+    st_d.addFrame(x.data());
+    in_d.push_back(countInsideEllipsoids(x.data(), nv, pinned, e_end));
+  }
+  finish(out.bullet, st_b, pen_b, in_b);
+  finish(out.drape, st_d, pen_d, in_d);
+  return true;
+}
+
+}  // namespace bench

@@ -1,0 +1,49 @@
+// The peer in the same run: Bullet's soft-body cloth (Debian libbullet-dev, 3.24) dressed in the
+// same T-shirt mesh on the same body, replayed over the same take at the same frame rate.
+//
+// A Drape context runs alongside as the driver: it tracks the body, builds the tracking
+// ellipsoids and the body mesh, and its own garment (the default setting) gives the attachment
+// targets (its pinned particles end every step at their targets) and the starting shape (the
+// garment once placed on the first tracked pose). Bullet gets: a soft body made from the garment's
+// rest positions and triangles (links from the edges, bending constraints at distance 2, the same
+// mass: 0.2 kg/m^2), its attached nodes as kinematic nodes moved to the same targets across the
+// substeps, each tracking ellipsoid as a kinematic btMultiSphereShape (one unit sphere, scaled by
+// the radii) moved across the substeps, gravity, 4 mm collision margin (Drape's), `substeps` fixed
+// substeps per 1/60 s and `iterations` position iterations. Only btSoftRigidDynamicsWorld::
+// stepSimulation is timed for Bullet; Drape's cloth step in the same frame is timed beside it.
+// Both garments are measured by the same meters (metrics.h) on the same frames (all but the first).
+#pragma once
+
+#include "scenario.h"
+
+#include <string>
+#include <vector>
+
+namespace bench {
+
+struct PeerSide {
+  std::vector<double> ms;  // per frame: Bullet's stepSimulation / Drape's garment step (cloth only)
+  std::vector<double> frame_ms;  // Drape only: push + whole step (skeleton, body, proxies, cloth)
+  double stretch_p99 = 0, stretch_max = 0;
+  double penetration_p99_mm = 0, penetration_max_mm = 0, deeper_than_2mm = 0;
+  double inside_mean = 0;  // free vertices inside any tracking ellipsoid, per frame
+  bool finite = true;
+};
+
+struct PeerResult {
+  std::string label;  // e.g. "4 x 10"
+  std::string take;
+  double rate_hz = 0;
+  int substeps_per_60hz = 0;
+  int iterations = 0;
+  uint32_t particles = 0;
+  PeerSide bullet, drape;
+};
+
+// True when this drape-bench was built with Bullet.
+bool bulletAvailable();
+// Runs one Bullet setting beside Drape's default one. false + error on failure.
+bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, int iterations, PeerResult& out,
+                   std::string& error);
+
+}  // namespace bench

@@ -1,0 +1,384 @@
+// drape-bench: run time against error for every setting that trades one for the other, over real
+// recordings, with Bullet's soft body as a peer in the same run. Writes one CSV and one PNG per
+// sweep, bullet_peer.csv and summary.md into --out. Method and results: docs/benchmarks.md.
+#include <drape/drape.h>
+
+#include "bullet_peer.h"
+#include "energy.h"
+#include "metrics.h"
+#include "plot.h"
+#include "report.h"
+#include "results.h"
+#include "scenario.h"
+#include "sweeps.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#ifndef DRAPE_BENCH_BUNDLED_TAKE
+#define DRAPE_BENCH_BUNDLED_TAKE ""
+#endif
+#ifndef DRAPE_SHARED_DATA_DIR
+#define DRAPE_SHARED_DATA_DIR ""
+#endif
+
+namespace fs = std::filesystem;
+using namespace bench;
+
+namespace {
+
+constexpr int kExitOk = 0, kExitFailure = 1, kExitUsage = 2;
+
+struct TakeSpec {
+  std::string path;
+  uint32_t stride = 1;
+};
+
+struct Options {
+  bool quick = false;
+  bool help = false;
+  bool bullet = true;
+  bool plots = true;
+  std::string out = "drape-bench-out";
+  std::vector<TakeSpec> takes;
+  double seconds = 0;         // per take; 0 = mode default
+  int repeats = 0;            // 0 = mode default
+  double energy_seconds = 0;  // 0 = mode default
+  std::set<std::string> sweeps;
+};
+
+const char* kHelp =
+    "usage: drape-bench [--quick] [--out DIR] [--take PATH[@STRIDE]]... [--seconds S] [--repeats N]\n"
+    "                   [--sweeps a,b,...] [--energy-seconds S] [--no-bullet] [--no-plots]\n"
+    "Sweeps Drape's speed/accuracy settings over real takes and writes, into DIR (default\n"
+    "drape-bench-out): <sweep>.csv and <sweep>.png per sweep, bullet_peer.csv, summary.md.\n"
+    "  --quick           a few points per sweep, one 1 s take, one repeat (CI: under a minute)\n"
+    "  --take PATH@N     a recording (Kinect CSV, BVH, .drec), replaying every N-th frame;\n"
+    "                    default: the shared Kinect take and the CMU BVH hop take at 60 Hz\n"
+    "                    (the bundled Kinect take with --quick or without ../shared/data)\n"
+    "  --seconds S       seconds of each take to replay (default 5, quick 1)\n"
+    "  --repeats N       timed repeats per setting (default 3, quick 1)\n"
+    "  --sweeps LIST     subset of: solver,substeps,iterations,ring_points,contact_response,\n"
+    "                    continuous_collision,resolution,backend\n"
+    "  --energy-seconds S  free-hanging energy-drift run length (default 2, quick 0.5)\n"
+    "  --no-bullet       skip the Bullet peer;  --no-plots  skip gnuplot\n";
+
+bool parseNumber(const std::string& s, double lo, double hi, double& out) {
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  if (s.empty() || *end != '\0' || !(v >= lo && v <= hi)) return false;
+  out = v;
+  return true;
+}
+
+bool parse(int argc, char** argv, Options& o, std::string& err) {
+  const std::vector<std::string> names = sweepNames();
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&](std::string& v) {
+      if (i + 1 >= argc) {
+        err = a + " needs a value";
+        return false;
+      }
+      v = argv[++i];
+      return true;
+    };
+    std::string v;
+    double d = 0;
+    if (a == "--quick") o.quick = true;
+    else if (a == "--help" || a == "-h") o.help = true;
+    else if (a == "--no-bullet") o.bullet = false;
+    else if (a == "--no-plots") o.plots = false;
+    else if (a == "--out") {
+      if (!value(o.out)) return false;
+    } else if (a == "--take") {
+      if (!value(v)) return false;
+      TakeSpec t;
+      const size_t at = v.rfind('@');
+      t.path = v.substr(0, at);
+      if (at != std::string::npos) {
+        if (!parseNumber(v.substr(at + 1), 1, 100, d)) return err = "--take " + v + ": stride must be 1..100", false;
+        t.stride = static_cast<uint32_t>(d);
+      }
+      o.takes.push_back(t);
+    } else if (a == "--seconds") {
+      if (!value(v) || !parseNumber(v, 0.1, 3600, o.seconds)) return err = "--seconds must be in [0.1, 3600]", false;
+    } else if (a == "--energy-seconds") {
+      if (!value(v) || !parseNumber(v, 0.05, 600, o.energy_seconds))
+        return err = "--energy-seconds must be in [0.05, 600]", false;
+    } else if (a == "--repeats") {
+      if (!value(v) || !parseNumber(v, 1, 100, d)) return err = "--repeats must be in [1, 100]", false;
+      o.repeats = static_cast<int>(d);
+    } else if (a == "--sweeps") {
+      if (!value(v)) return false;
+      std::stringstream ss(v);
+      std::string s;
+      while (std::getline(ss, s, ',')) {
+        if (std::find(names.begin(), names.end(), s) == names.end()) return err = "unknown sweep '" + s + "'", false;
+        o.sweeps.insert(s);
+      }
+    } else {
+      err = "unknown argument '" + a + "' (see --help)";
+      return false;
+    }
+  }
+  return true;
+}
+
+// The OpenCL backend is a sweep axis once the library has one (issue 5); this build's C ABI has
+// no backend selection yet, so the axis holds the CPU only.
+bool openclBackendAvailable() { return false; }
+
+struct Runner {
+  const Options& opt;
+  int repeats;
+  double energy_seconds;
+  std::map<std::string, Row> done;                       // key + take -> row
+  std::map<std::string, RunResult> references;           // reference key + take
+  std::map<std::string, EnergyDrift> energies;           // solver/hz/iterations/particles
+
+  bool row(const Take& take, const Setting& s, Row& out, std::string& err) {
+    const std::string id = s.key() + "|" + take.name;
+    auto hit = done.find(id);
+    if (hit != done.end()) {
+      out = hit->second;
+      out.setting = s;
+      return true;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    Row r;
+    r.setting = s;
+    r.take = take.name;
+    r.rate_hz = take.rate_hz;
+    r.repeats = repeats;
+    // Measuring run: every frame's vertices and error figures (outside the timed calls).
+    RunResult measured;
+    RunOptions mo;
+    mo.measure = true;
+    mo.keep_positions = true;
+    if (!runDrape(take, s, mo, measured, err)) return false;
+    r.particles = measured.particles;
+    r.substeps_per_frame = measured.substeps_per_frame;
+    r.stretch_p99 = measured.stretch_p99;
+    r.stretch_max = measured.stretch_max;
+    r.pen_p99_mm = measured.penetration_p99_mm;
+    r.pen_max_mm = measured.penetration_max_mm;
+    r.deeper_than_2mm = measured.deeper_than_2mm;
+    r.inside_mean = measured.inside_mean;
+    r.inside_max = measured.inside_max;
+    r.nan_resets = measured.nan_resets;
+    // The converged reference of the same input, shared by every setting that differs only in
+    // substeps and iterations.
+    Setting ref_key_setting = s;
+    ref_key_setting.substep_hz = s.solver == DRAPE_SOLVER_MASS_SPRING ? kMassSpringSubstepHz : Setting{}.substep_hz;
+    ref_key_setting.iterations = 1;
+    const Setting ref = ref_key_setting.reference();
+    const std::string ref_id = ref.key() + "|" + take.name;
+    if (!references.count(ref_id)) {
+      RunResult rr;
+      RunOptions ro;
+      ro.keep_positions = true;
+      std::fprintf(stderr, "drape-bench:   reference %s ...\n", ref.key().c_str());
+      if (!runDrape(take, ref, ro, rr, err)) return false;
+      references[ref_id] = std::move(rr);
+    }
+    const RunResult& rr = references[ref_id];
+    DeviationMeter dev;
+    for (size_t f = 0; f < measured.positions.size() && f < rr.positions.size(); ++f)
+      dev.addFrame(measured.positions[f].data(), rr.positions[f].data(), measured.positions[f].size());
+    r.dev_rms_mm = dev.rmsMm();
+    r.dev_max_mm = dev.maxMm();
+    // Timed repeats.
+    std::vector<FrameTimes> frames;
+    for (int k = 0; k < repeats; ++k) {
+      RunResult timed;
+      if (!runDrape(take, s, RunOptions{}, timed, err)) return false;
+      frames.insert(frames.end(), timed.times.begin(), timed.times.end());
+    }
+    fillTimes(frames, take.rate_hz, r);
+    // Energy drift of the free-hanging garment (independent of the take and the body proxies).
+    char ekey[128];
+    std::snprintf(ekey, sizeof ekey, "%d %g %u %u", s.solver, s.substep_hz, s.iterations, s.particles);
+    if (!energies.count(ekey)) {
+      EnergyDrift e;
+      if (!energyDrift(s, energy_seconds, e, err)) return false;
+      energies[ekey] = e;
+    }
+    r.energy = energies[ekey];
+    done[id] = r;
+    out = r;
+    std::fprintf(stderr, "drape-bench: %-22s %-22s %-16s frame %.3f ms, dev %.2f mm, pen P99 %.2f mm (%.1f s)\n",
+                 s.sweep.c_str(), s.label.c_str(), take.name.c_str(), r.frame.median, r.dev_rms_mm, r.pen_p99_mm,
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    return true;
+  }
+};
+
+std::string commandLine(int argc, char** argv) {
+  std::string c = "drape-bench";
+  for (int i = 1; i < argc; ++i) c += std::string(" ") + argv[i];
+  return c;
+}
+
+int run(int argc, char** argv) {
+  Options opt;
+  std::string err;
+  if (!parse(argc, argv, opt, err)) {
+    std::fprintf(stderr, "drape-bench: error: %s\n", err.c_str());
+    return kExitUsage;
+  }
+  if (opt.help) {
+    std::fputs(kHelp, stdout);
+    return kExitOk;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const double seconds = opt.seconds > 0 ? opt.seconds : (opt.quick ? 1.0 : 5.0);
+  const int repeats = opt.repeats > 0 ? opt.repeats : (opt.quick ? 1 : 3);
+  const double energy_seconds = opt.energy_seconds > 0 ? opt.energy_seconds : (opt.quick ? 0.5 : 2.0);
+  if (opt.takes.empty()) {
+    const fs::path shared(DRAPE_SHARED_DATA_DIR);
+    const fs::path kinect = shared / "kinect_v2_msft_labanotation/Ges01_wavehand.csv";
+    const fs::path bvh = shared / "cmu_mocap_bvh/scaled_131_03.bvh";
+    if (!opt.quick && fs::exists(kinect) && fs::exists(bvh)) {
+      opt.takes.push_back({kinect.string(), 1});
+      opt.takes.push_back({bvh.string(), 2});  // 120 Hz mocap replayed at 60 Hz
+    } else {
+      opt.takes.push_back({DRAPE_BENCH_BUNDLED_TAKE, 1});
+    }
+  }
+  std::vector<Take> takes;
+  for (const TakeSpec& ts : opt.takes) {
+    Take probe;
+    if (!loadTake(ts.path, 3, ts.stride, probe, err)) {
+      std::fprintf(stderr, "drape-bench: error: %s\n", err.c_str());
+      return kExitUsage;
+    }
+    Take t;
+    const auto frames = static_cast<uint32_t>(std::max(3.0, std::round(seconds * probe.rate_hz)));
+    if (!loadTake(ts.path, frames, ts.stride, t, err)) {
+      std::fprintf(stderr, "drape-bench: error: %s\n", err.c_str());
+      return kExitUsage;
+    }
+    takes.push_back(std::move(t));
+  }
+  std::error_code ec;
+  fs::create_directories(opt.out, ec);
+  if (!fs::is_directory(opt.out)) {
+    std::fprintf(stderr, "drape-bench: error: cannot create --out directory '%s'\n", opt.out.c_str());
+    return kExitUsage;
+  }
+
+  ReportInput report;
+  report.command = commandLine(argc, argv);
+  report.takes = takes;
+  report.energy_seconds = energy_seconds;
+  Runner runner{opt, repeats, energy_seconds, {}, {}, {}};
+  for (const Sweep& sw : makeSweeps(opt.quick, openclBackendAvailable())) {
+    if (!opt.sweeps.empty() && !opt.sweeps.count(sw.name)) continue;
+    std::vector<Row> rows;
+    for (const Take& t : takes) {
+      for (const Setting& s : sw.settings) {
+        Row r;
+        if (!runner.row(t, s, r, err)) {
+          std::fprintf(stderr, "drape-bench: error: %s / %s on %s: %s\n", sw.name.c_str(), s.label.c_str(),
+                       t.name.c_str(), err.c_str());
+          return kExitFailure;
+        }
+        rows.push_back(r);
+      }
+    }
+    if (!writeRowsCsv((fs::path(opt.out) / (sw.name + ".csv")).string(), rows, err)) {
+      std::fprintf(stderr, "drape-bench: error: %s\n", err.c_str());
+      return kExitFailure;
+    }
+    std::string note;
+    if (opt.plots && !plotSweep(opt.out, sw.name, sw.title, rows, note)) report.notes.push_back(note);
+    report.sweeps.push_back(sw);
+    report.rows.push_back(std::move(rows));
+  }
+  // The paper's Table 1: the default setting at the template size closest to 2 000 particles.
+  uint32_t table1_target = Setting{}.particles;
+  if (!templateTargetFor(2000, table1_target, err)) {
+    std::fprintf(stderr, "drape-bench: error: %s\n", err.c_str());
+    return kExitFailure;
+  }
+  for (const Take& t : takes) {
+    Setting s;
+    s.sweep = "table1";
+    s.label = "default, ~2000 particles";
+    s.particles = table1_target;
+    Row r;
+    if (!runner.row(t, s, r, err)) {
+      std::fprintf(stderr, "drape-bench: error: Table 1 run on %s: %s\n", t.name.c_str(), err.c_str());
+      return kExitFailure;
+    }
+    report.table1.push_back(r);
+  }
+  if (!writeRowsCsv((fs::path(opt.out) / "table1.csv").string(), report.table1, err)) {
+    std::fprintf(stderr, "drape-bench: error: %s\n", err.c_str());
+    return kExitFailure;
+  }
+  if (!openclBackendAvailable())
+    report.notes.push_back("backend sweep: this library has no backend selection in its C ABI yet, so only the CPU "
+                           "backend was measured");
+
+  if (opt.bullet && !bulletAvailable()) {
+    std::string why;
+    PeerResult unused;
+    runBulletPeer(takes[0], 0, 0, 0, unused, why);
+    report.peer_note = why;
+    std::fprintf(stderr, "drape-bench: note: %s\n", why.c_str());
+  } else if (opt.bullet) {
+    const std::vector<std::pair<int, int>> settings =
+        opt.quick ? std::vector<std::pair<int, int>>{{4, 10}} : std::vector<std::pair<int, int>>{{1, 10}, {4, 10}};
+    // Every take in a full run (the BVH take is replayed at 60 Hz, the rate Bullet's and NvCloth's
+    // figures are quoted for); the first one with --quick.
+    const size_t peer_takes = opt.quick ? 1 : takes.size();
+    for (size_t ti = 0; ti < peer_takes; ++ti) {
+      for (const auto& [sub, it] : settings) {
+        PeerResult p;
+        const auto t0 = std::chrono::steady_clock::now();
+        if (!runBulletPeer(takes[ti], table1_target, sub, it, p, err)) {
+          std::fprintf(stderr, "drape-bench: error: Bullet peer: %s\n", err.c_str());
+          return kExitFailure;
+        }
+        std::fprintf(stderr, "drape-bench: Bullet %s on %s: %.2f ms per frame, Drape %.3f ms: %.0fx (%.1f s)\n",
+                     p.label.c_str(), p.take.c_str(), median(p.bullet.ms), median(p.drape.ms),
+                     median(p.bullet.ms) / median(p.drape.ms),
+                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+        report.peers.push_back(p);
+      }
+    }
+    if (!writePeerCsv((fs::path(opt.out) / "bullet_peer.csv").string(), report.peers, err)) {
+      std::fprintf(stderr, "drape-bench: error: %s\n", err.c_str());
+      return kExitFailure;
+    }
+  } else {
+    report.peer_note = "Skipped (--no-bullet).";
+  }
+  const std::string summary = (fs::path(opt.out) / "summary.md").string();
+  std::ofstream(summary) << renderReport(report);
+  std::fprintf(stderr, "drape-bench: wrote %s (%.1f s in all)\n", summary.c_str(),
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  return kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "drape-bench: error: %s\n", e.what());
+    return kExitFailure;
+  }
+}

@@ -1,0 +1,122 @@
+#include "metrics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <utility>
+
+namespace bench {
+
+namespace {
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+}
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return kNaN;
+  const double rank = std::ceil(p / 100.0 * static_cast<double>(v.size()));
+  const size_t k = std::min(v.size() - 1, static_cast<size_t>(std::max(rank, 1.0)) - 1);
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+double median(const std::vector<double>& v) { return percentile(v, 50.0); }
+
+double mean(const std::vector<double>& v) {
+  if (v.empty()) return kNaN;
+  double s = 0.0;
+  for (double x : v) s += x;
+  return s / static_cast<double>(v.size());
+}
+
+double maximum(const std::vector<double>& v) {
+  return v.empty() ? kNaN : *std::max_element(v.begin(), v.end());
+}
+
+bool PenetrationMeter::setBody(const std::vector<drape_vec3>& positions, const std::vector<uint32_t>& indices) {
+  scratch_.resize(positions.size());
+  for (size_t i = 0; i < positions.size(); ++i)
+    scratch_[i] = drape::Vec3(positions[i].x, positions[i].y, positions[i].z);
+  return bvh_.build(scratch_, indices);  // a refit after the first frame (same topology)
+}
+
+void PenetrationMeter::addFrame(const drape_vec3* vertices, size_t count) {
+  for (size_t i = 0; i < count; ++i) {
+    const float sd = bvh_.signedDistance(drape::Vec3(vertices[i].x, vertices[i].y, vertices[i].z));
+    const double depth = sd < 0.0f ? -static_cast<double>(sd) * 1000.0 : 0.0;
+    depth_mm_.push_back(depth);
+    if (depth > 2.0) ++deep_;
+  }
+}
+
+double PenetrationMeter::p99Mm() const { return percentile(depth_mm_, 99.0); }
+double PenetrationMeter::maxMm() const { return maximum(depth_mm_); }
+double PenetrationMeter::deeperThan2mmFraction() const {
+  return depth_mm_.empty() ? kNaN : static_cast<double>(deep_) / static_cast<double>(depth_mm_.size());
+}
+
+void StretchMeter::setMesh(const std::vector<uint32_t>& indices, const std::vector<drape_vec3>& rest) {
+  std::map<std::pair<uint32_t, uint32_t>, bool> seen;
+  a_.clear();
+  b_.clear();
+  rest_.clear();
+  for (size_t t = 0; t + 2 < indices.size(); t += 3) {
+    for (int e = 0; e < 3; ++e) {
+      uint32_t i = indices[t + e], j = indices[t + (e + 1) % 3];
+      if (i > j) std::swap(i, j);
+      if (!seen.emplace(std::make_pair(i, j), true).second) continue;
+      const double dx = rest[i].x - rest[j].x, dy = rest[i].y - rest[j].y, dz = rest[i].z - rest[j].z;
+      const double len = std::sqrt(dx * dx + dy * dy + dz * dz);
+      if (!(len > 0.0)) continue;  // a zero-length rest edge has no stretch ratio
+      a_.push_back(i);
+      b_.push_back(j);
+      rest_.push_back(len);
+    }
+  }
+}
+
+void StretchMeter::addFrame(const drape_vec3* x) {
+  for (size_t k = 0; k < a_.size(); ++k) {
+    const drape_vec3& p = x[a_[k]];
+    const drape_vec3& q = x[b_[k]];
+    const double dx = p.x - q.x, dy = p.y - q.y, dz = p.z - q.z;
+    samples_.push_back(std::sqrt(dx * dx + dy * dy + dz * dz) / rest_[k] - 1.0);
+  }
+}
+
+uint32_t countInsideEllipsoids(const drape_vec3* v, size_t count, const std::vector<uint8_t>& skip,
+                               const std::vector<drape_ellipsoid>& ellipsoids) {
+  constexpr float kInsideTol = 1e-4f;  // 0.1 mm along the ray from the centre, as the library
+  uint32_t inside = 0;
+  for (size_t i = 0; i < count; ++i) {
+    if (i < skip.size() && skip[i]) continue;
+    for (const drape_ellipsoid& e : ellipsoids) {
+      const float px = v[i].x - e.centre.x, py = v[i].y - e.centre.y, pz = v[i].z - e.centre.z;
+      const float ux = (px * e.axis_x.x + py * e.axis_x.y + pz * e.axis_x.z) / e.radii.x;
+      const float uy = (px * e.axis_y.x + py * e.axis_y.y + pz * e.axis_y.z) / e.radii.y;
+      const float uz = (px * e.axis_z.x + py * e.axis_z.y + pz * e.axis_z.z) / e.radii.z;
+      const float r = std::sqrt(ux * ux + uy * uy + uz * uz);
+      const float dist = std::sqrt(px * px + py * py + pz * pz);
+      if (r < 1.0f && (1.0f - r) * dist > kInsideTol * std::max(r, 1e-6f)) {
+        ++inside;
+        break;
+      }
+    }
+  }
+  return inside;
+}
+
+void DeviationMeter::addFrame(const drape_vec3* run, const drape_vec3* ref, size_t count) {
+  if (count == 0) return;
+  double sum2 = 0.0, worst = 0.0;
+  for (size_t i = 0; i < count; ++i) {
+    const double dx = run[i].x - ref[i].x, dy = run[i].y - ref[i].y, dz = run[i].z - ref[i].z;
+    const double d2 = dx * dx + dy * dy + dz * dz;
+    sum2 += d2;
+    worst = std::max(worst, d2);
+  }
+  rms_mm_.push_back(1000.0 * std::sqrt(sum2 / static_cast<double>(count)));
+  max_mm_.push_back(1000.0 * std::sqrt(worst));
+}
+
+}  // namespace bench

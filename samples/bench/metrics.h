@@ -1,0 +1,74 @@
+// Error figures measured the same way for every simulator drape-bench runs (Drape at any setting,
+// Bullet's soft body): any garment vertex array against the body mesh of the same frame, the
+// structural edges of the garment mesh against their rest lengths, the tracking ellipsoids, and a
+// reference run's vertices. Everything pools per-frame samples so that P99 and max are taken over
+// all vertices (or edges) of all measured frames.
+#pragma once
+
+#include <drape/drape.h>
+
+#include "proxies/mesh_bvh.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace bench {
+
+// Percentile by nearest rank (p in (0, 100]) of a copy of v; NaN when empty.
+double percentile(std::vector<double> v, double p);
+double median(const std::vector<double>& v);
+double mean(const std::vector<double>& v);
+double maximum(const std::vector<double>& v);
+
+// Depth of garment vertices inside the body mesh (signed distance through drape's TriangleBvh,
+// the same query drape_garment_measure uses), pooled over frames.
+class PenetrationMeter {
+ public:
+  // body: this frame's body mesh (drape_context_read_body_mesh). Returns false if unusable.
+  bool setBody(const std::vector<drape_vec3>& positions, const std::vector<uint32_t>& indices);
+  void addFrame(const drape_vec3* vertices, size_t count);
+  double p99Mm() const;
+  double maxMm() const;
+  double deeperThan2mmFraction() const;  // vertex-frames more than 2 mm inside
+  size_t samples() const { return depth_mm_.size(); }
+
+ private:
+  drape::TriangleBvh bvh_;
+  std::vector<drape::Vec3> scratch_;
+  std::vector<double> depth_mm_;
+  size_t deep_ = 0;
+};
+
+// Stretch |len| / rest - 1 of each structural edge (each undirected triangle edge once).
+class StretchMeter {
+ public:
+  void setMesh(const std::vector<uint32_t>& indices, const std::vector<drape_vec3>& rest);
+  void addFrame(const drape_vec3* vertices);
+  double p99() const { return percentile(samples_, 99.0); }
+  double max() const { return maximum(samples_); }
+  size_t edges() const { return a_.size(); }
+
+ private:
+  std::vector<uint32_t> a_, b_;
+  std::vector<double> rest_, samples_;
+};
+
+// Vertices strictly inside (> 0.1 mm, as drape_garment_measure counts) any of the ellipsoids,
+// `skip` marking vertices to leave out (pinned ones).
+uint32_t countInsideEllipsoids(const drape_vec3* vertices, size_t count, const std::vector<uint8_t>& skip,
+                               const std::vector<drape_ellipsoid>& ellipsoids);
+
+// Per-frame distance to a reference run's vertices (same mesh, same frame): RMS and max in mm,
+// each averaged over the frames added.
+class DeviationMeter {
+ public:
+  void addFrame(const drape_vec3* run, const drape_vec3* reference, size_t count);
+  double rmsMm() const { return mean(rms_mm_); }
+  double maxMm() const { return mean(max_mm_); }
+  size_t frames() const { return rms_mm_.size(); }
+
+ private:
+  std::vector<double> rms_mm_, max_mm_;
+};
+
+}  // namespace bench

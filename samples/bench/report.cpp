@@ -1,0 +1,177 @@
+#include "report.h"
+
+#include "metrics.h"
+
+#include <cstdarg>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+namespace bench {
+
+namespace {
+
+// The paper's Table 1 at 2 000 particles, K = 20 (a 2016 GPU, per displayed frame; ANCHORS.md).
+constexpr double kPaperFrameMs = 41.1, kPaperCollideMs = 36.4, kPaperIntegrateMs = 3.9, kPaperBodyMs = 0.78;
+// NvCloth 1.1.6 CPU, 2 016 particles, 300 Hz, tethers on: 0.39 ms per 1/60 s (ANCHORS.md).
+constexpr double kNvClothMsPer60Hz = 0.39;
+// Bullet 4 x 10 on this kind of machine (ANCHORS.md): 36 ms per 1/60 s.
+constexpr double kBulletAnchorMsPer60Hz = 36.0;
+
+#if defined(__GNUC__)
+__attribute__((format(printf, 2, 3)))
+#endif
+void appendf(std::string& o, const char* fmt, ...) {
+  char line[1024];
+  va_list a;
+  va_start(a, fmt);
+  std::vsnprintf(line, sizeof line, fmt, a);
+  va_end(a);
+  o += line;
+}
+
+std::string firstLineWith(const char* path, const std::string& prefix) {
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind(prefix, 0) == 0) return line.substr(prefix.size());
+  return "";
+}
+
+const Row* defaultRow(const ReportInput& in, const std::string& take) {
+  for (const auto& rs : in.rows)
+    for (const Row& r : rs)
+      if (r.take == take && r.setting.is_default) return &r;
+  return nullptr;
+}
+
+}  // namespace
+
+std::string machineDescription() {
+  std::string cpu = firstLineWith("/proc/cpuinfo", "model name\t: ");
+  std::string os = firstLineWith("/etc/os-release", "PRETTY_NAME=");
+  if (os.size() >= 2 && os.front() == '"') os = os.substr(1, os.size() - 2);
+  std::string o = (cpu.empty() ? std::string("unknown CPU") : cpu) + ", " +
+                  std::to_string(std::thread::hardware_concurrency()) + " logical CPUs visible, " +
+                  (os.empty() ? std::string("unknown OS") : os);
+#if defined(__VERSION__) && defined(__GNUC__) && !defined(__clang__)
+  o += ", g++ " __VERSION__;
+#elif defined(__VERSION__)
+  o += ", " __VERSION__;
+#endif
+#if defined(__OPTIMIZE__)
+  o += ", optimised build";
+#else
+  o += ", UNOPTIMISED build (timings meaningless)";
+#endif
+  return o + ", one thread";
+}
+
+std::string renderReport(const ReportInput& in) {
+  std::string o = "# drape-bench results\n\n";
+  appendf(o, "- command: `%s`\n- machine: %s\n- Drape %s\n", in.command.c_str(), machineDescription().c_str(),
+          drape_version_string());
+  for (const Take& t : in.takes)
+    appendf(o, "- take `%s`: %zu frames replayed at %.0f Hz (%.1f s)\n", t.name.c_str(), t.frames.size(), t.rate_hz,
+            static_cast<double>(t.frames.size()) / t.rate_hz);
+  o += "\nTimes: median (p90) over every steady frame of every timed repeat, ms per replayed frame. Errors from "
+       "one measuring run: deviation = RMS / max vertex distance to the converged reference (16x substeps, 4x "
+       "iterations), averaged over frames; stretch = P99 / max over all structural edges of all frames; "
+       "penetration = P99 / max depth of all garment vertices of all frames inside the body mesh; inside = "
+       "particles inside an ellipsoid they collide with, mean per frame; energy = drift of the free-hanging "
+       "garment as a fraction of M g H (docs/benchmarks.md).\n";
+  for (size_t k = 0; k < in.sweeps.size(); ++k) {
+    appendf(o, "\n## %s (`%s.csv`)\n\n", in.sweeps[k].title.c_str(), in.sweeps[k].name.c_str());
+    o += "| setting | take | frame ms | cloth ms | collide ms | deviation mm RMS / max | stretch % P99 / max | "
+         "penetration mm P99 / max | > 2 mm % | inside | energy drift |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const Row& r : in.rows[k]) {
+      char energy[32];
+      std::snprintf(energy, sizeof energy, "%+.4f", r.energy.drift);
+      appendf(o, "| %s%s | %s | %.3f (%.3f) | %.3f | %.3f | %.2f / %.1f | %.2f / %.1f | %.2f / %.1f | %.3f | %.2f | %s |\n",
+              r.setting.label.c_str(), r.setting.is_default ? " **(default)**" : "", r.take.c_str(), r.frame.median,
+              r.frame.p90, r.cloth.median, r.collide.median, r.dev_rms_mm, r.dev_max_mm, 100.0 * r.stretch_p99,
+              100.0 * r.stretch_max, r.pen_p99_mm, r.pen_max_mm, 100.0 * r.deeper_than_2mm, r.inside_mean,
+              r.energy.exploded ? "exploded" : energy);
+    }
+  }
+
+  // The paper's Table 1 beside ours.
+  for (const Row& t1 : in.table1) {
+    const Row* d = &t1;
+    {
+      appendf(o, "\n## The paper's Table 1 beside ours (%u particles, K = %u, take `%s`)\n\n", d->particles,
+              d->setting.ring_points, d->take.c_str());
+      o += "| stage | Drape median ms | Drape p90 ms | paper ms (2016 GPU, per displayed frame) |\n|---|---|---|---|\n";
+      appendf(o, "| skeleton | %.3f | %.3f | - |\n", d->skeleton.median, d->skeleton.p90);
+      appendf(o, "| body (rings + mesh) | %.3f | %.3f | %.2f |\n", d->body.median, d->body.p90, kPaperBodyMs);
+      appendf(o, "| proxies | %.3f | %.3f | ~0 |\n", d->proxies.median, d->proxies.p90);
+      appendf(o, "| cloth: integration + constraints | %.3f | %.3f | %.1f |\n", d->integrate.median, d->integrate.p90,
+              kPaperIntegrateMs);
+      appendf(o, "| cloth: collision | %.3f | %.3f | %.1f |\n", d->collide.median, d->collide.p90, kPaperCollideMs);
+      appendf(o, "| whole frame | %.3f | %.3f | %.1f |\n", d->frame.median, d->frame.p90, kPaperFrameMs);
+      appendf(o, "\nOur frame is 1/%.0f s of motion at %.0f substeps; the paper's a displayed frame (~24 FPS).\n",
+              d->rate_hz, d->substeps_per_frame);
+    }
+  }
+
+  // The peer.
+  o += "\n## Bullet soft body beside Drape, same run\n\n";
+  if (in.peers.empty()) {
+    o += in.peer_note.empty() ? std::string("Not run.\n") : in.peer_note + "\n";
+  } else {
+    o += "The same mesh, attachments, ellipsoids and frames for both; cloth step only (Bullet: stepSimulation; "
+         "Drape: its garment step, measured beside it in the same frame), median ms. Penetration and stretch by "
+         "the same meters for both; inside = free vertices inside any tracking ellipsoid (Drape's garments "
+         "collide only with their own body parts' ellipsoids, so sleeve cloth resting on the torso counts here).\n\n";
+    o += "| take | engine | setting | ms per frame | ms per 1/60 s | Bullet / Drape | stretch % P99 / max | penetration mm "
+         "P99 / max | > 2 mm % | inside |\n|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const PeerResult& p : in.peers) {
+      const double b = median(p.bullet.ms), d = median(p.drape.ms);
+      appendf(o, "| %s (%.0f Hz, %u particles) | Bullet 3.24 | %s (substeps per 1/60 s x iterations) | %.2f | %.2f | **%.0fx** | %.1f / %.1f | %.1f / %.1f | %.2f | %.1f |\n",
+              p.take.c_str(), p.rate_hz, p.particles, p.label.c_str(), b, b * p.rate_hz / 60.0, b / d,
+              100.0 * p.bullet.stretch_p99, 100.0 * p.bullet.stretch_max, p.bullet.penetration_p99_mm,
+              p.bullet.penetration_max_mm, 100.0 * p.bullet.deeper_than_2mm, p.bullet.inside_mean);
+      appendf(o, "| | Drape | default, beside it | %.3f | %.3f | 1 | %.2f / %.1f | %.2f / %.1f | %.2f | %.2f |\n", d,
+              d * p.rate_hz / 60.0, 100.0 * p.drape.stretch_p99, 100.0 * p.drape.stretch_max,
+              p.drape.penetration_p99_mm, p.drape.penetration_max_mm, 100.0 * p.drape.deeper_than_2mm,
+              p.drape.inside_mean);
+    }
+    for (const PeerResult& p : in.peers) {
+      if (p.substeps_per_60hz != 4 || p.iterations != 10) continue;
+      const double ratio = median(p.bullet.ms) / median(p.drape.ms);
+      const bool less_pen = p.drape.penetration_p99_mm <= p.bullet.penetration_p99_mm &&
+                            p.drape.deeper_than_2mm <= p.bullet.deeper_than_2mm;
+      const bool less_stretch = p.drape.stretch_p99 < p.bullet.stretch_p99;
+      appendf(o, "\nTarget on `%s` (Drape >= 50x faster than Bullet 4 x 10, with less penetration and stretch): "
+                 "%.0fx faster (%s), penetration %s, stretch %s. Bullet 4 x 10 here: %.1f ms per 1/60 s "
+                 "(ANCHORS.md: %.0f ms).\n",
+              p.take.c_str(), ratio, ratio >= 50.0 ? "met" : "NOT met", less_pen ? "less (met)" : "NOT less",
+              less_stretch ? "less (met)" : "NOT less", median(p.bullet.ms) * p.rate_hz / 60.0,
+              kBulletAnchorMsPer60Hz);
+    }
+  }
+
+  // NvCloth per simulated second.
+  if (!in.takes.empty()) {
+    const Row* d = in.table1.empty() ? defaultRow(in, in.takes[0].name) : &in.table1[0];
+    if (d) {
+      const double nv = kNvClothMsPer60Hz * 60.0;
+      const double cloth = d->cloth.median * d->rate_hz, frame = d->frame.median * d->rate_hz;
+      o += "\n## Against NvCloth (ANCHORS.md, measured on this kind of machine, not in this run)\n\n";
+      o += "| | ms per simulated second | vs NvCloth 1.1.6 (0.39 ms per 1/60 s = 23.4 ms/s, 2 016 particles, 300 Hz) |\n|---|---|---|\n";
+      appendf(o, "| NvCloth, cloth only | %.1f | 1 |\n", nv);
+      appendf(o, "| Drape default, cloth only (%u particles, take `%s`) | %.1f | %.2fx %s |\n", d->particles,
+              d->take.c_str(), cloth, cloth > nv ? cloth / nv : nv / cloth, cloth > nv ? "slower" : "faster");
+      appendf(o, "| Drape default, whole frame (skeleton + body + proxies + cloth) | %.1f | %.2fx %s |\n", frame,
+              frame > nv ? frame / nv : nv / frame, frame > nv ? "slower" : "faster");
+    }
+  }
+  if (!in.notes.empty()) {
+    o += "\n## Notes\n\n";
+    for (const std::string& n : in.notes) o += "- " + n + "\n";
+  }
+  return o;
+}
+
+}  // namespace bench

@@ -1,0 +1,245 @@
+#include "scenario.h"
+
+#include "metrics.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+
+namespace bench {
+
+namespace {
+
+struct ContextDeleter {
+  void operator()(drape_context* c) const { drape_context_destroy(c); }
+};
+struct RecordingDeleter {
+  void operator()(drape_recording* r) const { drape_recording_destroy(r); }
+};
+
+}  // namespace
+
+std::string libraryError(const char* call, drape_result r) {
+  const char* msg = drape_last_error();
+  return std::string(call) + " failed: " + drape_result_name(r) + (msg && *msg ? std::string(": ") + msg : "");
+}
+
+bool loadTake(const std::string& path, uint32_t frames, uint32_t stride, Take& out, std::string& error) {
+  drape_recording* raw = nullptr;
+  if (drape_result r = drape_recording_open(path.c_str(), DRAPE_LAYOUT_AUTO, &raw)) {
+    error = libraryError(("drape_recording_open(" + path + ")").c_str(), r);
+    return false;
+  }
+  std::unique_ptr<drape_recording, RecordingDeleter> rec(raw);
+  drape_recording_info info{};
+  info.struct_size = sizeof info;
+  if (drape_result r = drape_recording_get_info(rec.get(), &info)) {
+    error = libraryError("drape_recording_get_info", r);
+    return false;
+  }
+  Take t;
+  t.path = path;
+  t.name = std::filesystem::path(path).stem().string();
+  t.layout = info.layout;
+  t.joint_count = info.joint_count;
+  stride = std::max<uint32_t>(stride, 1);
+  for (uint32_t i = 0; i < info.frame_count && (frames == 0 || t.frames.size() < frames); i += stride) {
+    std::vector<drape_joint> joints(info.joint_count);
+    double ts = 0.0;
+    if (drape_result r = drape_recording_read_frame(rec.get(), i, joints.data(), info.joint_count, &ts)) {
+      error = libraryError("drape_recording_read_frame", r);
+      return false;
+    }
+    t.frames.push_back(std::move(joints));
+    t.timestamps_s.push_back(ts);
+  }
+  if (t.frames.size() < 3) {
+    error = "recording '" + path + "' has fewer than 3 frames to replay";
+    return false;
+  }
+  std::vector<double> dts;
+  for (size_t i = 1; i < t.timestamps_s.size(); ++i) dts.push_back(t.timestamps_s[i] - t.timestamps_s[i - 1]);
+  const double dt = median(dts);
+  t.rate_hz = dt > 0.0 ? 1.0 / dt : 30.0;
+  out = std::move(t);
+  return true;
+}
+
+std::string Setting::key() const {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "s%d hz%g it%u K%u rule%d resp%d ccd%u n%u %s", solver, substep_hz, iterations,
+                ring_points, proxy_rule, contact_response, continuous_collision, particles, backend.c_str());
+  return buf;
+}
+
+Setting Setting::reference() const {
+  Setting r = *this;
+  r.sweep = "reference";
+  r.label = "reference";
+  r.is_default = false;
+  r.substep_hz = std::min(16.0f * substep_hz, 20000.0f);
+  if (solver == DRAPE_SOLVER_XPBD) r.iterations = std::min<uint32_t>(4 * iterations, 64);
+  return r;
+}
+
+bool templateTargetFor(uint32_t wanted, uint32_t& target, std::string& error) {
+  drape_context* raw = nullptr;
+  if (drape_result r = drape_context_create(nullptr, &raw)) return error = libraryError("drape_context_create", r), false;
+  std::unique_ptr<drape_context, ContextDeleter> ctx(raw);
+  uint32_t t = wanted, best = wanted, best_gap = UINT32_MAX;
+  for (int attempt = 0; attempt < 4; ++attempt) {
+    drape_garment_template tmpl;
+    drape_garment_template_init(&tmpl);
+    tmpl.particles = t;
+    drape_garment* g = nullptr;
+    if (drape_result r = drape_context_add_garment_template(ctx.get(), nullptr, &tmpl, nullptr, &g))
+      return error = libraryError("drape_context_add_garment_template", r), false;
+    uint32_t nv = 0, ni = 0;
+    drape_garment_get_mesh_size(g, &nv, &ni);
+    drape_garment_destroy(g);
+    const uint32_t gap = nv > wanted ? nv - wanted : wanted - nv;
+    if (gap < best_gap) {
+      best_gap = gap;
+      best = t;
+    }
+    if (gap == 0 || nv == 0) break;
+    t = static_cast<uint32_t>(std::lround(static_cast<double>(t) * wanted / nv));
+  }
+  target = best;
+  return true;
+}
+
+bool runDrape(const Take& take, const Setting& s, const RunOptions& o, RunResult& out, std::string& error) {
+  using Clock = std::chrono::steady_clock;
+  out = RunResult{};
+  drape_context_desc desc;
+  drape_context_desc_init(&desc);
+  desc.ring_points = s.ring_points;
+  desc.proxy_rule = s.proxy_rule;
+  drape_context* raw = nullptr;
+  if (drape_result r = drape_context_create(&desc, &raw)) {
+    error = libraryError("drape_context_create", r);
+    return false;
+  }
+  std::unique_ptr<drape_context, ContextDeleter> ctx(raw);
+  if (s.backend != "cpu") {
+    error = "backend '" + s.backend + "' is not available in this build";
+    return false;
+  }
+  drape_garment_desc gdesc;
+  drape_garment_desc_init(&gdesc);
+  gdesc.solver = s.solver;
+  drape_cloth_params cloth;
+  drape_cloth_params_init(&cloth);
+  cloth.substep_hz = s.substep_hz;
+  cloth.iterations = s.iterations;
+  cloth.contact_response = s.contact_response;
+  cloth.continuous_collision = s.continuous_collision;
+  // Room for a whole frame of the take at this rate (the reference runs thousands of Hz).
+  const auto per_frame = static_cast<uint32_t>(std::ceil(s.substep_hz / take.rate_hz));
+  cloth.max_substeps = std::max(cloth.max_substeps, std::min<uint32_t>(1000, 2 * per_frame));
+  drape_garment_template tmpl;
+  drape_garment_template_init(&tmpl);
+  tmpl.kind = DRAPE_GARMENT_TSHIRT;
+  tmpl.particles = s.particles;
+  drape_garment* garment = nullptr;
+  if (drape_result r = drape_context_add_garment_template(ctx.get(), &gdesc, &tmpl, &cloth, &garment)) {
+    error = libraryError("drape_context_add_garment_template", r);
+    return false;
+  }
+  uint32_t nv = 0, ni = 0;
+  if (drape_result r = drape_garment_get_mesh_size(garment, &nv, &ni)) {
+    error = libraryError("drape_garment_get_mesh_size", r);
+    return false;
+  }
+  out.particles = nv;
+  out.indices.resize(ni);
+  out.rest.resize(nv);
+  drape_garment_read_mesh(garment, nullptr, nullptr, 0, out.indices.data(), ni);
+  drape_garment_read_rest_positions(garment, out.rest.data(), nv);
+
+  uint32_t body_nv = 0, body_ni = 0;
+  drape_context_get_body_mesh_size(ctx.get(), &body_nv, &body_ni);
+  std::vector<drape_vec3> body(body_nv);
+  std::vector<uint32_t> body_idx(body_ni);
+  drape_context_read_body_mesh(ctx.get(), nullptr, nullptr, 0, body_idx.data(), body_ni);
+
+  PenetrationMeter pen;
+  StretchMeter stretch;
+  stretch.setMesh(out.indices, out.rest);
+  std::vector<drape_vec3> x(nv);
+  std::vector<double> inside, substeps;
+  for (size_t i = 0; i < take.frames.size(); ++i) {
+    drape_skeleton_frame f{};
+    f.struct_size = sizeof f;
+    f.layout = take.layout;
+    f.joint_count = take.joint_count;
+    f.timestamp_s = take.timestamps_s[i];
+    f.joints = take.frames[i].data();
+    const double dt = i == 0 ? 1.0 / take.rate_hz : take.timestamps_s[i] - take.timestamps_s[i - 1];
+    const Clock::time_point t0 = Clock::now();
+    if (drape_result r = drape_context_push_skeleton(ctx.get(), &f)) {
+      error = libraryError("drape_context_push_skeleton", r);
+      return false;
+    }
+    if (drape_result r = drape_context_step(ctx.get(), static_cast<float>(std::min(std::max(dt, 1e-4), 1.0)))) {
+      error = libraryError("drape_context_step", r);
+      return false;
+    }
+    const double frame_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    drape_frame_stats fs{};
+    fs.struct_size = sizeof fs;
+    drape_context_get_frame_stats(ctx.get(), &fs);
+    drape_garment_stats gs{};
+    gs.struct_size = sizeof gs;
+    drape_garment_get_stats(garment, &gs);
+    out.attached = gs.attached;
+    out.nan_resets += gs.nan_reset;
+    substeps.push_back(gs.substeps);
+    // The first frame (pose blended in over extra frames) and teleports are not steady frames.
+    if (gs.blend_frames == 0 && !gs.teleport_reset)
+      out.times.push_back({frame_ms, fs.skeleton_ms, fs.body_ms, fs.proxies_ms, gs.step_ms, gs.integrate_ms,
+                           gs.collide_ms});
+    if (!o.measure && !o.keep_positions) continue;
+    if (drape_result r = drape_garment_read_mesh(garment, x.data(), nullptr, nv, nullptr, 0)) {
+      error = libraryError("drape_garment_read_mesh", r);
+      return false;
+    }
+    if (o.keep_positions) out.positions.push_back(x);
+    if (!o.measure) continue;
+    if (out.pinned.empty()) {  // attached particles: w = 0 in the borrowed view
+      const float* xyzw = nullptr;
+      uint32_t n = 0;
+      drape_garment_view_positions(garment, &xyzw, &n);
+      out.pinned.assign(nv, 0);
+      for (uint32_t k = 0; k < n && k < nv; ++k) out.pinned[k] = xyzw[4 * k + 3] == 0.0f;
+    }
+    drape_garment_accuracy acc{};
+    acc.struct_size = sizeof acc;
+    drape_garment_measure(garment, &acc);
+    inside.push_back(acc.proxy_inside);
+    out.inside_max = std::max(out.inside_max, acc.proxy_inside);
+    drape_context_read_body_mesh(ctx.get(), body.data(), nullptr, body_nv, nullptr, 0);
+    if (!pen.setBody(body, body_idx)) {
+      error = "the body mesh could not be measured (non-finite vertex?)";
+      return false;
+    }
+    pen.addFrame(x.data(), nv);
+    stretch.addFrame(x.data());
+  }
+  out.substeps_per_frame = median(substeps);
+  if (o.measure) {
+    out.stretch_p99 = stretch.p99();
+    out.stretch_max = stretch.max();
+    out.penetration_p99_mm = pen.p99Mm();
+    out.penetration_max_mm = pen.maxMm();
+    out.deeper_than_2mm = pen.deeperThan2mmFraction();
+    out.inside_mean = mean(inside);
+  }
+  return true;
+}
+
+}  // namespace bench

@@ -1,0 +1,345 @@
+// Each OpenCL kernel on its own against the CPU function it mirrors (docs/opencl.md): the
+// collision kernel against EllipsoidCollider::collide (moving ellipsoids, swept test, friction,
+// groups, overlaps that need the escape step, both responses), one constraint colour group
+// against the XPBD projection formula, vertex normals against vertexNormals, the transform
+// kernel against XpbdSolver::transform; plus the program's build log reaching the error and the
+// device choice failing cleanly. Tolerances: float rounding (the device may fuse multiply-adds
+// and uses its own rsqrt), stated per test.
+#include "opencl_test_support.h"
+
+#if DRAPE_HAVE_OPENCL
+#include "backends/opencl/cl_shapes.h"
+#include "backends/opencl/cl_stages.h"
+#include "backends/opencl/cl_xpbd_solver.h"
+#endif
+#include "body/mesh_metrics.h"
+#include "cloth/garment_topology.h"
+#include "cloth/xpbd_solver.h"
+#include "proxies/collision.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+namespace drape {
+namespace {
+
+#if DRAPE_HAVE_OPENCL
+DclF4 f4(const Eigen::Vector4f& v) { return DclF4{v.x(), v.y(), v.z(), v.w()}; }
+Eigen::Vector4f v4(const DclF4& v) { return Eigen::Vector4f(v.x, v.y, v.z, v.w); }
+
+Ellipsoid makeEllipsoid(const Vec3& c, const Vec3& radii, float angle, const Vec3& axis) {
+  Ellipsoid e;
+  e.centre = c;
+  e.radii = radii;
+  e.rotation = Eigen::AngleAxisf(angle, axis.normalized()).toRotationMatrix();
+  e.refresh();
+  return e;
+}
+
+// Overlapping, moving, rotated ellipsoids (a torso, an arm against it, a small flat one) and
+// particles scattered around and inside them, moving.
+struct CollisionScene {
+  std::vector<Ellipsoid> start, end;
+  std::vector<uint8_t> groups, masks;
+  std::vector<Eigen::Vector4f> x, prev;
+};
+
+CollisionScene collisionScene(unsigned seed) {
+  CollisionScene s;
+  s.start = {makeEllipsoid(Vec3(0, 1.2f, 0), Vec3(0.15f, 0.3f, 0.12f), 0.1f, Vec3(0, 0, 1)),
+             makeEllipsoid(Vec3(0.2f, 1.3f, 0), Vec3(0.05f, 0.2f, 0.05f), 0.3f, Vec3(0, 0, 1)),
+             makeEllipsoid(Vec3(-0.1f, 1.0f, 0.1f), Vec3(0.1f, 0.02f, 0.08f), 0.5f, Vec3(1, 1, 0))};
+  s.end = {makeEllipsoid(Vec3(0.02f, 1.21f, 0.01f), Vec3(0.15f, 0.3f, 0.12f), 0.15f, Vec3(0, 0, 1)),
+           makeEllipsoid(Vec3(0.18f, 1.32f, 0.03f), Vec3(0.05f, 0.2f, 0.05f), 0.45f, Vec3(0, 0, 1)),
+           makeEllipsoid(Vec3(-0.12f, 1.0f, 0.12f), Vec3(0.1f, 0.02f, 0.08f), 0.6f, Vec3(1, 1, 0))};
+  s.groups = {1, 2, 4};
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (int i = 0; i < 4000; ++i) {
+    const Vec3 p(0.3f * u(rng), 1.2f + 0.4f * u(rng), 0.2f * u(rng));
+    const Vec3 d(0.03f * u(rng), 0.03f * u(rng), 0.03f * u(rng));
+    const float w = i % 50 == 0 ? 0.0f : 1.0f;  // some pinned: never touched
+    s.prev.emplace_back(p.x(), p.y(), p.z(), w);
+    s.x.emplace_back(p.x() + d.x(), p.y() + d.y(), p.z() + d.z(), w);
+    s.masks.push_back(static_cast<uint8_t>(i % 3 == 0 ? 0xFF : (i % 3 == 1 ? 1 : 3)));
+  }
+  return s;
+}
+
+struct CollisionCase {
+  ContactResponse response;
+  bool continuous, grouped;
+  float max_escape;
+};
+
+class OpenClCollideKernel : public ::testing::TestWithParam<CollisionCase> {};
+
+TEST_P(OpenClCollideKernel, MatchesCpuCollider) {
+  DRAPE_REQUIRE_OPENCL(rt);
+  const CollisionCase c = GetParam();
+  CollisionScene s = collisionScene(7);
+  CollisionParams p;
+  p.response = c.response;
+  p.continuous = c.continuous;
+  p.max_escape_m = c.max_escape;
+  const float margin = 0.004f;
+  EllipsoidCollider cpu;
+  cpu.setEllipsoids(s.start.data(), s.end.data(), 3, margin);
+  if (c.grouped) cpu.setGroups(s.groups, s.masks.data());
+  std::vector<Eigen::Vector4f> expect = s.x;
+  const CollisionStats cs = cpu.collide(expect.data(), s.prev.data(), expect.size(), p);
+
+  std::vector<DrapeClShape> shapes;
+  std::vector<DclF4> bounds;
+  packFrameShapes(s.start.data(), s.end.data(), 3, margin, c.grouped ? s.groups : std::vector<uint8_t>{}, 1, 1,
+                  shapes, bounds);
+  std::vector<DclF4> x, prev;
+  for (size_t i = 0; i < s.x.size(); ++i) {
+    x.push_back(f4(s.x[i]));
+    prev.push_back(f4(s.prev[i]));
+  }
+  CollisionStats gs;
+  std::string err;
+  ASSERT_TRUE(clCollide(*rt, shapes, bounds, p, c.grouped ? s.masks : std::vector<uint8_t>{}, x, prev, gs, err)) << err;
+  // Positions within 2 um (float rounding in the closest-point iterations), pinned untouched,
+  // and the same contacts; every particle CPU-resolved is resolved on the device too.
+  float worst = 0.0f;
+  for (size_t i = 0; i < x.size(); ++i) {
+    if ((v4(x[i]) - expect[i]).head<3>().norm() > 2e-6f) {
+      std::vector<Eigen::Vector4f> one{s.x[i]};
+      const CollisionStats o = cpu.collide(one.data(), &s.prev[i], 1, p);
+      std::printf("i %zu d %g contacts %u swept %u esc %u tests %u |dx| %g\n", i, (v4(x[i]) - expect[i]).head<3>().norm(), o.contacts, o.swept_catches, o.escapes, o.tests, (s.x[i]-expect[i]).head<3>().norm());
+    }
+    worst = std::max(worst, (v4(x[i]) - expect[i]).head<3>().norm());
+    if (s.x[i].w() == 0.0f) EXPECT_EQ(v4(x[i]), s.x[i]);
+  }
+  EXPECT_LT(worst, 2e-6f);
+  EXPECT_GT(cs.contacts, 100u);  // the scene exercises contacts...
+  EXPECT_EQ(gs.contacts, cs.contacts);
+  EXPECT_EQ(gs.swept_catches, cs.swept_catches);
+  EXPECT_EQ(gs.escapes, cs.escapes);
+  EXPECT_EQ(gs.tests, cs.tests);
+}
+
+INSTANTIATE_TEST_SUITE_P(Cases, OpenClCollideKernel,
+                         ::testing::Values(CollisionCase{ContactResponse::Exact, true, true, 0.01f},
+                                           CollisionCase{ContactResponse::Exact, true, false, 0.0f},
+                                           CollisionCase{ContactResponse::Radial, true, true, 0.0f},
+                                           CollisionCase{ContactResponse::Exact, false, false, 0.01f}));
+
+TEST(OpenClCollideKernel, EscapeStepRunsOnOverlaps) {
+  // Without groups the arm and torso overlap: some particles need the escape step on both sides.
+  DRAPE_REQUIRE_OPENCL(rt);
+  CollisionScene s = collisionScene(11);
+  EllipsoidCollider cpu;
+  cpu.setEllipsoids(s.start.data(), s.end.data(), 3, 0.004f);
+  std::vector<Eigen::Vector4f> expect = s.x;
+  const CollisionStats cs = cpu.collide(expect.data(), s.prev.data(), expect.size(), CollisionParams{});
+  ASSERT_GT(cs.escapes, 0u);
+  std::vector<DrapeClShape> shapes;
+  std::vector<DclF4> bounds, x, prev;
+  packFrameShapes(s.start.data(), s.end.data(), 3, 0.004f, {}, 1, 1, shapes, bounds);
+  for (size_t i = 0; i < s.x.size(); ++i) {
+    x.push_back(f4(s.x[i]));
+    prev.push_back(f4(s.prev[i]));
+  }
+  CollisionStats gs;
+  std::string err;
+  ASSERT_TRUE(clCollide(*rt, shapes, bounds, CollisionParams{}, {}, x, prev, gs, err)) << err;
+  EXPECT_EQ(gs.escapes, cs.escapes);
+  // Guarantee of the unlimited escape: nothing ends inside any (inflated) end ellipsoid.
+  for (size_t i = 0; i < x.size(); ++i) {
+    if (s.x[i].w() == 0.0f) continue;
+    for (int k = 0; k < 3; ++k) {
+      const Ellipsoid e = cpu.inflatedEnd(k);
+      const float q = e.toUnit(v4(x[i]).head<3>()).norm();
+      EXPECT_GT(q, 1.0f - 1e-3f) << "particle " << i << " inside ellipsoid " << k;
+    }
+  }
+}
+
+TEST(OpenClKernels, ProjectGroupMatchesCpuFormula) {
+  DRAPE_REQUIRE_OPENCL(rt);
+  // Disjoint pairs (one colour group): particle 2k with 2k + 1, various masses and stretches.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<DclF4> x;
+  std::vector<DrapeClConstraint> c;
+  for (uint32_t k = 0; k < 500; ++k) {
+    const float wa = k % 7 == 0 ? 0.0f : 2.0f + u(rng), wb = 1.5f + u(rng);
+    x.push_back(DclF4{u(rng), u(rng), u(rng), wa});
+    x.push_back(DclF4{u(rng), u(rng), u(rng), wb});
+    const float compliance_h2 = k % 2 ? 0.0f : 0.5f;
+    c.push_back(DrapeClConstraint{2 * k, 2 * k + 1, 0.5f + 0.3f * u(rng), 1.0f / (wa + wb + compliance_h2)});
+  }
+  for (bool tether : {false, true}) {
+    std::vector<DclF4> got = x;
+    std::string err;
+    ASSERT_TRUE(clProjectGroup(*rt, c, 0, static_cast<uint32_t>(c.size()), tether, 1.1f, got, err)) << err;
+    for (size_t k = 0; k < c.size(); ++k) {
+      // XpbdSolver's scalar path: C = |d| - rest (tether: max(|d| - rest * scale, 0)).
+      Eigen::Vector4f a = v4(x[c[k].a]), b = v4(x[c[k].b]);
+      const Vec3 d = a.head<3>() - b.head<3>();
+      const float len = d.norm();
+      const float cc = tether ? std::max(len - c[k].rest * 1.1f, 0.0f) : len - c[k].rest;
+      const float s = cc / len * c[k].inv_w;
+      a.head<3>() -= (a.w() * s) * d;
+      if (!tether) b.head<3>() += (b.w() * s) * d;
+      EXPECT_LT((v4(got[c[k].a]) - a).norm(), 2e-6f) << k;
+      EXPECT_LT((v4(got[c[k].b]) - b).norm(), 2e-6f) << k;
+    }
+  }
+}
+
+TEST(OpenClKernels, VertexNormalsMatchCpu) {
+  DRAPE_REQUIRE_OPENCL(rt);
+  std::vector<float> flat;
+  std::vector<uint32_t> indices;
+  makeClothGrid(30, 20, 1.0f, 0.7f, Vec3::Zero(), Vec3::UnitX(), Vec3(0.0f, 0.3f, 1.0f), flat, indices);
+  std::vector<Vec3> pos(flat.size() / 3);
+  std::vector<DclF4> x(pos.size());
+  for (size_t i = 0; i < pos.size(); ++i) {
+    pos[i] = Vec3(flat[3 * i], flat[3 * i + 1] + 0.05f * std::sin(7.0f * flat[3 * i]), flat[3 * i + 2]);
+    x[i] = DclF4{pos[i].x(), pos[i].y(), pos[i].z(), 1.0f};
+  }
+  std::vector<Vec3> expect(pos.size());
+  vertexNormals(pos, indices, expect);
+  std::vector<DclF4> got;
+  std::string err;
+  ASSERT_TRUE(clVertexNormals(*rt, x, indices, got, err)) << err;
+  for (size_t i = 0; i < pos.size(); ++i)
+    EXPECT_LT((Vec3(got[i].x, got[i].y, got[i].z) - expect[i]).norm(), 1e-5f) << i;
+}
+
+GarmentTopology hangingSquare(int n) {
+  std::vector<float> positions;
+  std::vector<uint32_t> indices;
+  makeClothGrid(n, n, 1.0f, 1.0f, Vec3::Zero(), Vec3::UnitX(), Vec3(-Vec3::UnitY()), positions, indices);
+  TopologyParams p;
+  p.pinned = {0, static_cast<uint32_t>(n - 1)};
+  GarmentTopology t;
+  std::string error;
+  EXPECT_TRUE(buildGarmentTopology(positions.data(), positions.size() / 3, indices.data(), indices.size(), p, t, error));
+  return t;
+}
+
+TEST(OpenClKernels, TransformMatchesCpu) {
+  DRAPE_REQUIRE_OPENCL(rt);
+  const GarmentTopology t = hangingSquare(12);
+  XpbdSolver cpu(t);
+  std::string err;
+  auto cl = ClXpbdSolver::create(rt, t, {}, {}, err);
+  ASSERT_TRUE(cl) << err;
+  for (int f = 0; f < 3; ++f) {  // some velocity first
+    ASSERT_TRUE(cpu.step(1.0f / 30.0f));
+    ASSERT_TRUE(cl->step(1.0f / 30.0f));
+  }
+  const Mat3 R = Eigen::AngleAxisf(0.4f, Vec3(0.2f, 1.0f, 0.1f).normalized()).toRotationMatrix();
+  cpu.transform(R, Vec3(0.1f, -0.2f, 0.3f), Vec3(0.5f, 0.0f, -0.25f), 0.5f);
+  cl->transform(R, Vec3(0.1f, -0.2f, 0.3f), Vec3(0.5f, 0.0f, -0.25f), 0.5f);
+  for (size_t i = 0; i < t.particleCount(); ++i) {
+    EXPECT_LT((cl->positions()[i] - cpu.positions()[i]).norm(), 1e-5f);
+    EXPECT_LT((cl->velocities()[i] - cpu.velocities()[i]).norm(), 1e-4f);
+  }
+}
+
+TEST(OpenClRuntime, BuildLogReachesTheError) {
+  // A deliberately broken kernel appended through the internal hook: the build fails and the
+  // error carries the compiler's log naming the bad identifier.
+  if (!test::sharedClRuntime()) GTEST_SKIP() << "no usable OpenCL device";
+  ClChoice c;
+  c.extra_source = "__kernel void drape_broken(__global float* x) { x[0] = undefined_symbol_xyz; }\n";
+  std::string err;
+  EXPECT_FALSE(ClRuntime::create(c, err));
+  EXPECT_NE(err.find("build failed"), std::string::npos) << err;
+  EXPECT_NE(err.find("undefined_symbol_xyz"), std::string::npos) << err;
+}
+
+TEST(OpenClRuntime, BadDefineReachesTheError) {
+  if (!test::sharedClRuntime()) GTEST_SKIP() << "no usable OpenCL device";
+  ClChoice c;
+  c.extra_options = "-DDRAPE_CL_WORK_GROUP=banana";  // redefined to garbage: kernels.cl cannot compile
+  std::string err;
+  EXPECT_FALSE(ClRuntime::create(c, err));
+  EXPECT_NE(err.find("build failed"), std::string::npos) << err;
+}
+
+TEST(OpenClRuntime, ImpossibleDeviceIndexFails) {
+  std::string list_err;
+  const auto devices = listClDevices(list_err);
+  if (devices.empty()) GTEST_SKIP() << "no OpenCL platform: " << list_err;
+  ClChoice c;
+  c.device = 999;
+  std::string err;
+  EXPECT_FALSE(ClRuntime::create(c, err));
+  EXPECT_NE(err.find("device index 999"), std::string::npos) << err;
+  c.device = -1;
+  c.platform = 999;
+  err.clear();
+  EXPECT_FALSE(ClRuntime::create(c, err));
+  EXPECT_NE(err.find("platform index 999"), std::string::npos) << err;
+  // Every listed device has a name.
+  for (const ClDeviceDesc& d : devices) EXPECT_FALSE(d.device_name.empty());
+}
+#else
+TEST(OpenClKernels, Unavailable) { GTEST_SKIP() << "built without OpenCL"; }
+#endif
+
+}  // namespace
+}  // namespace drape
+
+namespace drape {
+namespace {
+#if DRAPE_HAVE_OPENCL
+// The frame kernel (every substep in one launch) against XpbdSolver::step: a hanging square
+// swept by a moving ellipsoid, collision every second substep, one frame and then 20.
+TEST(OpenClKernels, FrameMatchesXpbdStep) {
+  DRAPE_REQUIRE_OPENCL(rt);
+  std::vector<float> positions;
+  std::vector<uint32_t> indices;
+  makeClothGrid(24, 24, 1.0f, 1.0f, Vec3(-0.5f, 0.0f, -0.5f), Vec3::UnitX(), Vec3::UnitZ(), positions, indices);
+  TopologyParams tp;
+  tp.pinned = {0, 23};
+  GarmentTopology t;
+  std::string err;
+  ASSERT_TRUE(buildGarmentTopology(positions.data(), positions.size() / 3, indices.data(), indices.size(), tp, t, err));
+  XpbdParams p;
+  p.collision_stride = 2;
+  p.drag = 0.3f;
+  p.wind = Vec3(0.5f, 0.0f, 0.2f);
+  XpbdSolver cpu(t), cpu2(t);
+  ASSERT_TRUE(cpu2.setParams(p, err));
+  for (size_t i = 0; i < t.particleCount(); ++i) cpu2.mutablePositions()[i].x() += 1e-6f;
+  auto gpu = ClXpbdSolver::create(rt, t, {}, {}, err);
+  ASSERT_TRUE(gpu) << err;
+  ASSERT_TRUE(cpu.setParams(p, err));
+  ASSERT_TRUE(gpu->setParams(p, err));
+  EllipsoidCollider collider;
+  for (int f = 0; f < 20; ++f) {
+    const float a = 0.05f * static_cast<float>(f), b = 0.05f * static_cast<float>(f + 1);
+    const Ellipsoid e0 = makeEllipsoid(Vec3(0.1f * a, -0.35f + a, 0.0f), Vec3(0.3f, 0.2f, 0.25f), a, Vec3(0, 1, 0));
+    const Ellipsoid e1 = makeEllipsoid(Vec3(0.1f * b, -0.35f + b, 0.0f), Vec3(0.3f, 0.2f, 0.25f), b, Vec3(0, 1, 0));
+    ASSERT_TRUE(cpu.setColliderMotion(&collider, &e0, &e1, 1, 0.004f, err));
+    ASSERT_TRUE(gpu->setColliderMotion(&e0, &e1, 1, 0.004f, {}, err));
+    ASSERT_TRUE(cpu2.setColliderMotion(&collider, &e0, &e1, 1, 0.004f, err));
+    ASSERT_TRUE(cpu2.step(1.0f / 30.0f, 10));
+    ASSERT_TRUE(cpu.step(1.0f / 30.0f, 10));
+    ASSERT_TRUE(gpu->step(1.0f / 30.0f, 10)) << gpu->lastError();
+    float worst = 0.0f;
+    for (size_t i = 0; i < t.particleCount(); ++i)
+      worst = std::max(worst, (gpu->positions()[i] - cpu.positions()[i]).head<3>().norm());
+    float chaos = 0.0f;
+    for (size_t i = 0; i < t.particleCount(); ++i)
+      chaos = std::max(chaos, (cpu2.positions()[i] - cpu.positions()[i]).head<3>().norm());
+    std::printf("frame %d gpu-cpu %g cpu-cpu(1um) %g contacts %u %u\n", f, worst, chaos, cpu.lastCollisionStats().contacts, gpu->lastCollisionStats().contacts);
+    if (f == 0) EXPECT_LT(worst, 1e-5f) << "first frame";
+    EXPECT_LT(worst, 1e-3f) << "frame " << f;
+    EXPECT_EQ(gpu->lastCollisionStats().contacts > 0, cpu.lastCollisionStats().contacts > 0) << f;
+  }
+  EXPECT_GT(cpu.lastCollisionStats().contacts, 0u);
+}
+#endif
+}  // namespace
+}  // namespace drape
