@@ -72,27 +72,29 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
 
   // The driver: Drape at its default setting.
   drape_context* raw = nullptr;
-  if (drape_result r = drape_context_create(nullptr, &raw)) return error = libraryError("drape_context_create", r), false;
+  if (drape_result r = drape_context_create(nullptr, &raw)) return failed("drape_context_create", r, error);
   std::unique_ptr<drape_context, ContextDeleter> ctx(raw);
   drape_garment_template tmpl;
   drape_garment_template_init(&tmpl);
   tmpl.particles = particles;
   drape_garment* garment = nullptr;
   if (drape_result r = drape_context_add_garment_template(ctx.get(), nullptr, &tmpl, nullptr, &garment))
-    return error = libraryError("drape_context_add_garment_template", r), false;
+    return failed("drape_context_add_garment_template", r, error);
   drape_cloth_params cloth;
   drape_cloth_params_init(&cloth);
-  drape_garment_get_params(garment, &cloth);
   uint32_t nv = 0, ni = 0, ne = 0, body_nv = 0, body_ni = 0;
-  drape_garment_get_mesh_size(garment, &nv, &ni);
-  drape_context_get_ellipsoid_count(ctx.get(), &ne);
-  drape_context_get_body_mesh_size(ctx.get(), &body_nv, &body_ni);
+  if (!ok("drape_garment_get_params", drape_garment_get_params(garment, &cloth), error) ||
+      !ok("drape_garment_get_mesh_size", drape_garment_get_mesh_size(garment, &nv, &ni), error) ||
+      !ok("drape_context_get_ellipsoid_count", drape_context_get_ellipsoid_count(ctx.get(), &ne), error) ||
+      !ok("drape_context_get_body_mesh_size", drape_context_get_body_mesh_size(ctx.get(), &body_nv, &body_ni), error))
+    return false;
   out.particles = nv;
   std::vector<uint32_t> indices(ni), body_idx(body_ni);
   std::vector<drape_vec3> rest(nv), x(nv), body(body_nv), bx(nv);
-  drape_garment_read_mesh(garment, nullptr, nullptr, 0, indices.data(), ni);
-  drape_garment_read_rest_positions(garment, rest.data(), nv);
-  drape_context_read_body_mesh(ctx.get(), nullptr, nullptr, 0, body_idx.data(), body_ni);
+  if (!ok("drape_garment_read_mesh", drape_garment_read_mesh(garment, nullptr, nullptr, 0, indices.data(), ni), error) ||
+      !ok("drape_garment_read_rest_positions", drape_garment_read_rest_positions(garment, rest.data(), nv), error) ||
+      !ok("drape_context_read_body_mesh", drape_context_read_body_mesh(ctx.get(), nullptr, nullptr, 0, body_idx.data(), body_ni), error))
+    return false;
   std::vector<drape_ellipsoid> e_start(ne), e_end(ne);
 
   auto pushStep = [&](size_t i, double& frame_ms, double& cloth_ms) -> bool {
@@ -104,18 +106,19 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
     f.joints = take.frames[i].data();
     const double dt = i == 0 ? 1.0 / take.rate_hz : take.timestamps_s[i] - take.timestamps_s[i - 1];
     const Clock::time_point t0 = Clock::now();
-    if (drape_result r = drape_context_push_skeleton(ctx.get(), &f)) return error = libraryError("push", r), false;
+    if (drape_result r = drape_context_push_skeleton(ctx.get(), &f)) return failed("drape_context_push_skeleton", r, error);
     if (drape_result r = drape_context_step(ctx.get(), static_cast<float>(std::min(std::max(dt, 1e-4), 1.0))))
-      return error = libraryError("drape_context_step", r), false;
+      return failed("drape_context_step", r, error);
     frame_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     drape_garment_stats gs{};
     gs.struct_size = sizeof gs;
-    drape_garment_get_stats(garment, &gs);
-    cloth_ms = gs.step_ms;
     uint32_t count = 0;
-    drape_context_read_ellipsoids(ctx.get(), e_end.data(), ne, &count);
-    drape_garment_read_mesh(garment, x.data(), nullptr, nv, nullptr, 0);
-    drape_context_read_body_mesh(ctx.get(), body.data(), nullptr, body_nv, nullptr, 0);
+    if (!ok("drape_garment_get_stats", drape_garment_get_stats(garment, &gs), error) ||
+        !ok("drape_context_read_ellipsoids", drape_context_read_ellipsoids(ctx.get(), e_end.data(), ne, &count), error) ||
+        !ok("drape_garment_read_mesh", drape_garment_read_mesh(garment, x.data(), nullptr, nv, nullptr, 0), error) ||
+        !ok("drape_context_read_body_mesh", drape_context_read_body_mesh(ctx.get(), body.data(), nullptr, body_nv, nullptr, 0), error))
+      return false;
+    cloth_ms = gs.step_ms;
     return true;
   };
   double frame_ms = 0, cloth_ms = 0;
@@ -124,7 +127,7 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
   {
     const float* xyzw = nullptr;
     uint32_t n = 0;
-    drape_garment_view_positions(garment, &xyzw, &n);
+    if (!ok("drape_garment_view_positions", drape_garment_view_positions(garment, &xyzw, &n), error)) return false;
     for (uint32_t k = 0; k < n && k < nv; ++k) pinned[k] = xyzw[4 * k + 3] == 0.0f;
   }
 

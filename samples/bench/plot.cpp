@@ -92,7 +92,7 @@ bool plotSweep(const std::string& dir, const std::string& stem, const std::strin
                  "set terminal pngcairo noenhanced size 1400,560 font 'DejaVu Sans,10'\nset output %s\n"
                  "set multiplot layout 1,2 title %s\nset grid\nset key top right\n"
                  "set xlabel 'whole frame, median ms (push + update + cloth)'\nset offsets graph 0.05, graph 0.2, "
-                 "graph 0.1, graph 0.1\n",
+                 "graph 0.1, graph 0\nset yrange [0:*]\n",
                  quoted(png).c_str(), quoted(title).c_str());
     // Times spanning more than a decade (the mass-spring solver, 8 000 particles) on a log axis.
     double lo = INFINITY, hi = 0.0;

@@ -27,6 +27,13 @@ std::string libraryError(const char* call, drape_result r) {
   return std::string(call) + " failed: " + drape_result_name(r) + (msg && *msg ? std::string(": ") + msg : "");
 }
 
+bool failed(const char* call, drape_result r, std::string& error) {
+  error = libraryError(call, r);
+  return false;
+}
+
+bool ok(const char* call, drape_result r, std::string& error) { return r == DRAPE_OK || failed(call, r, error); }
+
 bool loadTake(const std::string& path, uint32_t frames, uint32_t stride, Take& out, std::string& error) {
   drape_recording* raw = nullptr;
   if (drape_result r = drape_recording_open(path.c_str(), DRAPE_LAYOUT_AUTO, &raw)) {
@@ -87,7 +94,7 @@ Setting Setting::reference() const {
 
 bool templateTargetFor(uint32_t wanted, uint32_t& target, std::string& error) {
   drape_context* raw = nullptr;
-  if (drape_result r = drape_context_create(nullptr, &raw)) return error = libraryError("drape_context_create", r), false;
+  if (drape_result r = drape_context_create(nullptr, &raw)) return failed("drape_context_create", r, error);
   std::unique_ptr<drape_context, ContextDeleter> ctx(raw);
   uint32_t t = wanted, best = wanted, best_gap = UINT32_MAX;
   for (int attempt = 0; attempt < 4; ++attempt) {
@@ -96,10 +103,11 @@ bool templateTargetFor(uint32_t wanted, uint32_t& target, std::string& error) {
     tmpl.particles = t;
     drape_garment* g = nullptr;
     if (drape_result r = drape_context_add_garment_template(ctx.get(), nullptr, &tmpl, nullptr, &g))
-      return error = libraryError("drape_context_add_garment_template", r), false;
+      return failed("drape_context_add_garment_template", r, error);
     uint32_t nv = 0, ni = 0;
-    drape_garment_get_mesh_size(g, &nv, &ni);
+    const drape_result size_r = drape_garment_get_mesh_size(g, &nv, &ni);
     drape_garment_destroy(g);
+    if (size_r != DRAPE_OK) return failed("drape_garment_get_mesh_size", size_r, error);
     const uint32_t gap = nv > wanted ? nv - wanted : wanted - nv;
     if (gap < best_gap) {
       best_gap = gap;
@@ -158,14 +166,15 @@ bool runDrape(const Take& take, const Setting& s, const RunOptions& o, RunResult
   out.particles = nv;
   out.indices.resize(ni);
   out.rest.resize(nv);
-  drape_garment_read_mesh(garment, nullptr, nullptr, 0, out.indices.data(), ni);
-  drape_garment_read_rest_positions(garment, out.rest.data(), nv);
-
   uint32_t body_nv = 0, body_ni = 0;
-  drape_context_get_body_mesh_size(ctx.get(), &body_nv, &body_ni);
+  if (!ok("drape_garment_read_mesh", drape_garment_read_mesh(garment, nullptr, nullptr, 0, out.indices.data(), ni), error) ||
+      !ok("drape_garment_read_rest_positions", drape_garment_read_rest_positions(garment, out.rest.data(), nv), error) ||
+      !ok("drape_context_get_body_mesh_size", drape_context_get_body_mesh_size(ctx.get(), &body_nv, &body_ni), error))
+    return false;
   std::vector<drape_vec3> body(body_nv);
   std::vector<uint32_t> body_idx(body_ni);
-  drape_context_read_body_mesh(ctx.get(), nullptr, nullptr, 0, body_idx.data(), body_ni);
+  if (!ok("drape_context_read_body_mesh", drape_context_read_body_mesh(ctx.get(), nullptr, nullptr, 0, body_idx.data(), body_ni), error))
+    return false;
 
   PenetrationMeter pen;
   StretchMeter stretch;
@@ -192,10 +201,11 @@ bool runDrape(const Take& take, const Setting& s, const RunOptions& o, RunResult
     const double frame_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     drape_frame_stats fs{};
     fs.struct_size = sizeof fs;
-    drape_context_get_frame_stats(ctx.get(), &fs);
     drape_garment_stats gs{};
     gs.struct_size = sizeof gs;
-    drape_garment_get_stats(garment, &gs);
+    if (!ok("drape_context_get_frame_stats", drape_context_get_frame_stats(ctx.get(), &fs), error) ||
+        !ok("drape_garment_get_stats", drape_garment_get_stats(garment, &gs), error))
+      return false;
     out.attached = gs.attached;
     out.nan_resets += gs.nan_reset;
     substeps.push_back(gs.substeps);
@@ -213,16 +223,17 @@ bool runDrape(const Take& take, const Setting& s, const RunOptions& o, RunResult
     if (out.pinned.empty()) {  // attached particles: w = 0 in the borrowed view
       const float* xyzw = nullptr;
       uint32_t n = 0;
-      drape_garment_view_positions(garment, &xyzw, &n);
+      if (!ok("drape_garment_view_positions", drape_garment_view_positions(garment, &xyzw, &n), error)) return false;
       out.pinned.assign(nv, 0);
       for (uint32_t k = 0; k < n && k < nv; ++k) out.pinned[k] = xyzw[4 * k + 3] == 0.0f;
     }
     drape_garment_accuracy acc{};
     acc.struct_size = sizeof acc;
-    drape_garment_measure(garment, &acc);
+    if (!ok("drape_garment_measure", drape_garment_measure(garment, &acc), error) ||
+        !ok("drape_context_read_body_mesh", drape_context_read_body_mesh(ctx.get(), body.data(), nullptr, body_nv, nullptr, 0), error))
+      return false;
     inside.push_back(acc.proxy_inside);
     out.inside_max = std::max(out.inside_max, acc.proxy_inside);
-    drape_context_read_body_mesh(ctx.get(), body.data(), nullptr, body_nv, nullptr, 0);
     if (!pen.setBody(body, body_idx)) {
       error = "the body mesh could not be measured (non-finite vertex?)";
       return false;

@@ -93,5 +93,9 @@ bool templateTargetFor(uint32_t wanted, uint32_t& target, std::string& error);
 
 // Error text for a failed call: the result name and drape_last_error().
 std::string libraryError(const char* call, drape_result r);
+// For `if (drape_result r = call(...)) return failed("call", r, error);`: sets error, returns false.
+bool failed(const char* call, drape_result r, std::string& error);
+// True when r is DRAPE_OK; else sets error and returns false.
+bool ok(const char* call, drape_result r, std::string& error);
 
 }  // namespace bench

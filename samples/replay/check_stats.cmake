@@ -2,7 +2,7 @@
 # replay_garment_obj, replay_bvh).
 #   cmake -DEXE=... -DOUT_DIR=... -DARGS="a|b|c" -DEXPECT_FRAMES=N -DEXPECT_OBJ=N
 #         [-DEXPECT_GARMENT=template|obj|none -DEXPECT_GARMENT_OBJ=N -DEXPECT_MEASURED=N]
-#         [-DEXPECT_FORMAT=kinect_csv] [-DVOLUME_MIN_L=x -DVOLUME_MAX_L=y] [-DPYTHON=python3]
+#         [-DEXPECT_FORMAT=kinect_csv] [-DEXPECT_BACKEND=cpu|opencl] [-DVOLUME_MIN_L=x -DVOLUME_MAX_L=y] [-DPYTHON=python3]
 #         [-DEXPECT_RENDERED=N -DEXPECT_PNG_SIZE=WxH -DEXPECT_SHEET=ON|OFF -DEXPECT_GIF=ON|OFF]
 #         -P check_stats.cmake
 # EXPECT_GARMENT (default template) is garment.source. With a garment it requires particles > 0,
@@ -84,6 +84,40 @@ foreach(path "drape_version" "recording" "format" "layout" "frames" "rejected_fr
   string(REPLACE "|" ";" _keys "${path}")
   json_get(_unused ${_keys})
 endforeach()
+
+# The adaptive pipeline's counters (docs/adaptive.md). EXPECT_FULL_PIPELINE=ON (--full-pipeline):
+# every ellipsoid built every frame, nothing skipped, nothing slept; OFF: a garment world builds
+# fewer ellipsoids than there are (proxy culling).
+foreach(path "skipped|full_pipeline" "skipped|proxies_built" "skipped|proxies_available"
+             "skipped|stages_skipped" "skipped|frames_slept")
+  string(REPLACE "|" ";" _keys "${path}")
+  json_get(_unused ${_keys})
+endforeach()
+if(DEFINED EXPECT_FULL_PIPELINE)
+  json_get(_sk_full skipped full_pipeline)
+  json_get(_sk_built skipped proxies_built)
+  json_get(_sk_avail skipped proxies_available)
+  json_get(_sk_stages skipped stages_skipped)
+  json_get(_sk_slept skipped frames_slept)
+  if(NOT _sk_avail GREATER 0)
+    string(APPEND _failures "  skipped.proxies_available = ${_sk_avail}, expected > 0\n")
+  endif()
+  if(EXPECT_FULL_PIPELINE)
+    if(NOT _sk_full STREQUAL "ON" AND NOT _sk_full STREQUAL "true")
+      string(APPEND _failures "  skipped.full_pipeline = ${_sk_full}, expected true\n")
+    endif()
+    expect_equal("skipped.proxies_built" "${_sk_built}" "${_sk_avail}")
+    expect_equal("skipped.stages_skipped" "${_sk_stages}" 0)
+    expect_equal("skipped.frames_slept" "${_sk_slept}" 0)
+  else()
+    if(NOT _sk_full STREQUAL "OFF" AND NOT _sk_full STREQUAL "false")
+      string(APPEND _failures "  skipped.full_pipeline = ${_sk_full}, expected false\n")
+    endif()
+    if(NOT _sk_built LESS _sk_avail)
+      string(APPEND _failures "  skipped.proxies_built = ${_sk_built}, expected < ${_sk_avail} (culled)\n")
+    endif()
+  endif()
+endif()
 
 json_get(_frames frames)
 json_get(_rejected rejected_frames)
@@ -293,6 +327,20 @@ if(DEFINED EXPECT_GIF)
     endif()
   else()
     expect_type(NULL render gif)
+  endif()
+endif()
+
+# EXPECT_BACKEND (optional): stats.backend; "opencl" also needs a device name.
+if(DEFINED EXPECT_BACKEND)
+  json_get(_backend backend)
+  if(NOT _backend STREQUAL EXPECT_BACKEND)
+    json_get(_fallback backend_fallback)
+    string(APPEND _failures "  backend = ${_backend}, expected ${EXPECT_BACKEND} (fallback: ${_fallback})\n")
+  elseif(EXPECT_BACKEND STREQUAL "opencl")
+    json_get(_device device)
+    if(_device STREQUAL "" OR _device STREQUAL "NOTFOUND" OR _device MATCHES "NOTFOUND$")
+      string(APPEND _failures "  device is empty with backend opencl\n")
+    endif()
   endif()
 endif()
 

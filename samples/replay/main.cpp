@@ -148,6 +148,13 @@ int run(int argc, char** argv) {
                                 libraryReason(r) + "); use a multiple of 4 in [8, 256], e.g. 20");
   }
   std::unique_ptr<drape_context, ContextDeleter> ctx(raw_ctx);
+  if (opt.full_pipeline) {
+    drape_pipeline_options po;
+    drape_pipeline_options_init(&po);
+    po.cull_proxies = po.stages_on_demand = po.sleep = 0;
+    if (drape_result r = drape_context_set_pipeline_options(ctx.get(), &po))
+      return fail(kExitFailure, "drape_context_set_pipeline_options failed: " + libraryReason(r));
+  }
   if (opt.body_given) {
     if (drape_result r = drape_context_set_body_shape(ctx.get(), &opt.shape)) {
       if (isFatalLibraryError(r)) return fail(kExitFailure, "drape_context_set_body_shape failed: " + libraryReason(r));
@@ -206,6 +213,26 @@ int run(int argc, char** argv) {
   st.recording_rate_hz = info.nominal_rate_hz;
   st.ring_points = desc.ring_points;
   st.proxy_rule = desc.proxy_rule;
+  if (opt.backend == "opencl") {
+    // OpenCL for the cloth; without a working device the library falls back to the CPU and says
+    // why: the replay goes on and the stats record it (backend "cpu", backend_fallback).
+    drape_backend_desc bdesc;
+    drape_backend_desc_init(&bdesc);
+    bdesc.backend = DRAPE_BACKEND_OPENCL;
+    if (drape_result r = drape_context_set_backend(ctx.get(), &bdesc))
+      return fail(kExitFailure, "drape_context_set_backend failed: " + libraryReason(r));
+  }
+  {
+    drape_backend_info binfo;
+    binfo.struct_size = sizeof(binfo);
+    if (drape_result r = drape_context_get_backend_info(ctx.get(), &binfo))
+      return fail(kExitFailure, "drape_context_get_backend_info failed: " + libraryReason(r));
+    st.backend = binfo.active == DRAPE_BACKEND_OPENCL ? "opencl" : "cpu";
+    if (binfo.active == DRAPE_BACKEND_OPENCL) st.device = binfo.device_name;
+    st.backend_fallback = binfo.fallback_reason;
+    if (!st.backend_fallback.empty())
+      std::fprintf(stderr, "drape-replay: OpenCL not used, the cloth runs on the CPU: %s\n", st.backend_fallback.c_str());
+  }
   if (drape_result r = drape_context_get_ellipsoid_count(ctx.get(), &st.proxy_count))
     return fail(kExitFailure, "drape_context_get_ellipsoid_count failed: " + libraryReason(r));
   drape_body_shape_init(&st.shape);
@@ -347,6 +374,12 @@ int run(int argc, char** argv) {
     }
     const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     st.ms_per_frame.push_back(ms);
+    // Sampled before this frame's reads (mesh, fidelity) build what the update skipped.
+    drape_skip_stats skip{};
+    skip.struct_size = sizeof skip;
+    if (drape_result r = drape_context_get_skip_stats(ctx.get(), &skip))
+      return fail(kExitFailure, "drape_context_get_skip_stats failed: " + libraryReason(r));
+    st.proxies_built.push_back(skip.proxies_built);
     have_previous = true;
     previous_timestamp = timestamp;
 
@@ -453,6 +486,14 @@ int run(int argc, char** argv) {
   if (drape_result r = drape_context_get_frame_stats(ctx.get(), &final_stats))
     return fail(kExitFailure, "drape_context_get_frame_stats failed: " + libraryReason(r));
   st.teleports = final_stats.teleports;
+  st.full_pipeline = opt.full_pipeline;
+  drape_skip_stats final_skip{};
+  final_skip.struct_size = sizeof final_skip;
+  if (drape_result r = drape_context_get_skip_stats(ctx.get(), &final_skip))
+    return fail(kExitFailure, "drape_context_get_skip_stats failed: " + libraryReason(r));
+  st.proxies_available = final_skip.proxies_available;
+  st.stages_skipped = final_skip.stages_skipped;
+  st.frames_slept = final_skip.frames_slept;
 
   if (!stats_path.empty()) {
     const std::string json = replay::statsJson(st);

@@ -161,6 +161,9 @@ bool parseOptions(int argc, const char* const* argv, Options& o, std::string& er
     } else if (name == "--no-obj") {
       if (!flag()) return false;
       o.write_obj = false;
+    } else if (name == "--full-pipeline") {
+      if (!flag()) return false;
+      o.full_pipeline = true;
     } else if (name == "--recording") {
       if (!takeValue()) return false;
       if (value.empty()) {
@@ -286,12 +289,8 @@ bool parseOptions(int argc, const char* const* argv, Options& o, std::string& er
       o.render_options_given = true;
     } else if (name == "--backend") {
       if (!takeValue()) return false;
-      if (value == "opencl") {
-        error = "--backend opencl: the OpenCL backend is not built yet; use --backend cpu (the default)";
-        return false;
-      }
-      if (value != "cpu") {
-        error = "--backend '" + value + "' is not a backend; use --backend cpu (the only one in this build)";
+      if (value != "cpu" && value != "opencl") {
+        error = "--backend '" + value + "' is not a backend; use --backend cpu (the default) or opencl";
         return false;
       }
       o.backend = value;
@@ -406,7 +405,10 @@ std::string helpText() {
       "                        person's right) or both side by side (default)\n"
       "  --size WxH            size of one view in pixels, each in [64, 4096] (default 480x640)\n"
       "  --no-render           no pictures at all (same as --render-every 0)\n"
-      "  --backend B           cloth backend: cpu (the default and the only one in this build)\n"
+      "  --backend B           cloth backend: cpu (the default) or opencl (the XPBD step on an OpenCL\n"
+      "                        device, a GPU first; falls back to cpu with the reason when none works)\n"
+      "  --full-pipeline       run every stage every frame: no proxy culling, no sleeping garments\n"
+      "                        (the adaptive pipeline is the default; docs/adaptive.md)\n"
       "  --quiet, -q           no summary on stdout, no progress bar\n"
       "  --help, -h            this text\n"
       "\n"

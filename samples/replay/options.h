@@ -36,6 +36,9 @@ struct Options {
   std::string stats_path;          // empty: see resolveStatsPath
   bool quiet = false;
   bool help = false;
+  // --full-pipeline: every stage every frame, no proxy culling, no sleeping
+  // (drape_pipeline_options all off), to compare with the adaptive default.
+  bool full_pipeline = false;
 
   // Pictures (render.h): frames every N updated frames (0 = none), the views, the size of one view.
   bool render = true;              // --no-render: false
@@ -44,7 +47,7 @@ struct Options {
   std::string camera = "both";     // sensor | side | both
   uint32_t width = 480, height = 640;
   bool render_options_given = false;  // --camera or --size
-  std::string backend = "cpu";     // the only backend in this build
+  std::string backend = "cpu";     // "cpu" or "opencl" (drape_context_set_backend)
 };
 
 // Parses argv. On a bad argument returns false and sets `error` to a one-line message saying what

@@ -104,6 +104,11 @@ std::string statsJson(const ReplayStats& s) {
   w.key("rejected_frames").value(s.rejected_frames);
   w.key("teleports").value(s.teleports);
   w.key("nonfinite").value(static_cast<int64_t>(s.nonfinite));
+  w.key("backend").value(s.backend);
+  if (s.device.empty()) w.key("device").null();
+  else w.key("device").value(s.device);
+  if (s.backend_fallback.empty()) w.key("backend_fallback").null();
+  else w.key("backend_fallback").value(s.backend_fallback);
 
   w.key("ms_per_frame").beginObject();
   w.key("median").value(median(s.ms_per_frame));
@@ -192,6 +197,16 @@ std::string statsJson(const ReplayStats& s) {
   w.key("substeps").value(median(s.substeps));
   w.endObject();
 
+  // What the adaptive pipeline skipped: ellipsoids built per frame (median) of those available,
+  // stage runs skipped and steps in which every garment slept, over the whole replay.
+  w.key("skipped").beginObject();
+  w.key("full_pipeline").value(s.full_pipeline);
+  w.key("proxies_built").value(median(s.proxies_built));
+  w.key("proxies_available").value(s.proxies_available);
+  w.key("stages_skipped").value(static_cast<int64_t>(s.stages_skipped));
+  w.key("frames_slept").value(static_cast<int64_t>(s.frames_slept));
+  w.endObject();
+
   const RenderStats& r = s.render;
   auto pathOrNull = [&](const char* key, const std::string& path) {
     if (path.empty()) w.key(key).null();
@@ -234,6 +249,8 @@ std::string summaryText(const ReplayStats& s, const std::string& obj_dir, const 
         s.garment_kind.c_str(), s.garment_from_obj ? "OBJ" : "template",
         s.solver == DRAPE_SOLVER_MASS_SPRING ? "massspring" : "xpbd", s.substep_hz, s.particles, s.attached,
         s.garment_triangles);
+    appendf(o, "backend     %s%s%s%s\n", s.backend.c_str(), s.device.empty() ? "" : (" on " + s.device).c_str(),
+        s.backend_fallback.empty() ? "" : " (OpenCL not used: ", s.backend_fallback.empty() ? "" : (s.backend_fallback + ")").c_str());
     appendf(o, "stretch     max %.2f %%, P99 %.2f %% (%zu edges x %zu frames pooled)\n", 100.0 * s.stretch.max(),
         100.0 * s.stretch.percentile(99.0), s.stretch.edgeCount(), s.cloth_ms.size());
     if (!s.penetration_p99_mm.empty())

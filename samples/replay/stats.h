@@ -60,6 +60,9 @@ struct ReplayStats {
   std::string garment_kind;        // template name or the OBJ path
   bool garment_from_obj = false;
   int32_t solver = DRAPE_SOLVER_XPBD;
+  // Where the cloth ran (drape_context_get_backend_info after adding the garment): "cpu" or
+  // "opencl", the OpenCL device's name ("" on the CPU) and why OpenCL was asked for and not used.
+  std::string backend = "cpu", device, backend_fallback;
   double substep_hz = 0.0;         // drape_garment_get_params after adding
   uint32_t particles = 0;          // garment vertex count
   uint32_t garment_triangles = 0;
@@ -75,6 +78,13 @@ struct ReplayStats {
   std::vector<double> penetration_p99_mm, penetration_max_mm, deeper_than_2mm;
 
   RenderStats render;
+
+  // The adaptive pipeline (drape_context_get_skip_stats; docs/adaptive.md).
+  bool full_pipeline = false;        // --full-pipeline
+  std::vector<double> proxies_built; // per updated frame, right after the update / step
+  uint32_t proxies_available = 0;
+  uint64_t stages_skipped = 0;       // after the last frame
+  uint64_t frames_slept = 0;
 };
 
 // Median (mean of the two middle values for an even count) and nearest-rank percentile

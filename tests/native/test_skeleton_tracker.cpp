@@ -12,6 +12,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -161,6 +163,47 @@ TEST(SkeletonTrackerRecording, StaysNearTheRawTrackedJoints) {
         ASSERT_LT((out[i].position[0] - r.raw[i].position[0]).norm(), 0.05f) << "frame " << i;
       }
     }
+  }
+}
+
+// Sensor noise estimate (tracker.h, kNoiseReferenceM): on the real takes it stays at a few
+// millimetres, so the One-Euro filter works as tuned; with 5 cm Gaussian jitter added to every
+// joint it finds the jitter and divides beta by ~10; a skeleton flipped for one frame is a jump,
+// not noise. Measured (printed below): real takes 0.1-3.0 mm at the P95 of frames, 5 cm jitter
+// found as 44-46 mm (the median of a skewed estimate), a one-frame flip raises it to ~9 mm.
+TEST(SkeletonTrackerRecording, NoiseEstimateFindsJitterAndIgnoresJumps) {
+  for (const char* rel : kRecordings) {
+    DRAPE_REQUIRE_SHARED(path, rel);
+    SCOPED_TRACE(rel);
+    const Take r = loadKinect2Csv(path);
+    SkeletonTracker clean, jittered, flipped;
+    std::mt19937 rng(3);
+    std::normal_distribution<float> n(0.0f, 0.05f);
+    std::vector<double> sigma_clean, sigma_jitter;
+    float flip_sigma = 0.0f;
+    for (size_t i = 0; i < r.raw.size(); ++i) {
+      clean.push(r.raw[i], r.t[i]);
+      SkeletonPose noisy = r.raw[i], flip = r.raw[i];
+      for (Vec3& p : noisy.position) p += Vec3(n(rng), n(rng), n(rng));
+      jittered.push(noisy, r.t[i]);
+      if (i == r.raw.size() / 2)  // every joint reflected through the pelvis for one frame
+        for (Vec3& p : flip.position) p = 2.0f * r.raw[i].position[0] - p;
+      flipped.push(flip, r.t[i]);
+      if (i >= 30) {
+        sigma_clean.push_back(clean.noiseSigmaM());
+        sigma_jitter.push_back(jittered.noiseSigmaM());
+        flip_sigma = std::max(flip_sigma, flipped.noiseSigmaM());
+      }
+    }
+    ASSERT_GT(sigma_clean.size(), 20u);
+    const double p95 = percentile(sigma_clean, 0.95), jit = percentile(sigma_jitter, 0.5);
+    std::printf("[ noise    ] %s: clean P95 %.1f mm, beta %.2f; 5 cm jitter median %.1f mm, beta %.2f; flipped max %.1f mm\n",
+                rel, 1000 * p95, clean.effectiveBeta(), 1000 * jit, jittered.effectiveBeta(), 1000 * flip_sigma);
+    EXPECT_LT(p95, 0.006) << "the real sensor noise is millimetres";
+    EXPECT_GT(clean.effectiveBeta(), 0.8f * clean.params().beta);
+    EXPECT_NEAR(jit, 0.05, 0.015) << "the added jitter is found";
+    EXPECT_LT(jittered.effectiveBeta(), 0.15f * jittered.params().beta);
+    EXPECT_LT(flip_sigma, std::max(2.0 * p95, 0.01)) << "a one-frame flip is a jump, not noise";
   }
 }
 
@@ -446,6 +489,41 @@ TEST(SkeletonTracker, LostPelvisHeldThenBlendsBack) {
   EXPECT_FALSE(tr.teleportedLastPush());
   EXPECT_LT(maxStep, 0.1f);
   EXPECT_LT((tr.pose().position[0] - back.position[0]).norm(), 0.01f);
+}
+
+// A skeleton reflected through the pelvis (upside down, front and back swapped) is a pose jump:
+// flagged on the flip and on the way back, and the output lands on the new pose at once instead
+// of sweeping through the poses between. A pirouette at two turns a second is no pose jump.
+TEST(SkeletonTracker, FlippedSkeletonIsAPoseJumpAndAPirouetteIsNot) {
+  SkeletonTracker tr;
+  double t = pushStill(tr, standing(), 0.0, 40);
+  EXPECT_EQ(tr.poseJumpCount(), 0u);
+  SkeletonPose flip = standing();
+  for (Vec3& p : flip.position) p = 2.0f * standing().position[0] - p;
+  tr.push(flip, t);
+  t += kDt;
+  EXPECT_TRUE(tr.poseJumpedLastPush());
+  EXPECT_FALSE(tr.teleportedLastPush()) << "the pelvis did not move";
+  const int head = idx(Joint::Head);
+  EXPECT_LT((tr.pose().position[head] - flip.position[head]).norm(), 0.05f) << "landed on the flipped pose";
+  t = pushStill(tr, flip, t, 20);
+  EXPECT_FALSE(tr.poseJumpedLastPush());
+  tr.push(standing(), t);
+  t += kDt;
+  EXPECT_TRUE(tr.poseJumpedLastPush());
+  EXPECT_EQ(tr.poseJumpCount(), 2u);
+
+  SkeletonTracker spin;
+  const float turns_per_s = 2.0f;
+  double ts = 0.0;
+  for (int i = 0; i < 90; ++i, ts += kDt) {
+    const Mat3 R = Eigen::AngleAxisf(2.0f * 3.14159265f * turns_per_s * static_cast<float>(ts), Vec3::UnitY()).toRotationMatrix();
+    SkeletonPose p = standing();
+    for (Vec3& q : p.position) q = standing().position[0] + R * (q - standing().position[0]);
+    spin.push(p, ts);
+    EXPECT_FALSE(spin.poseJumpedLastPush()) << "frame " << i;
+  }
+  EXPECT_EQ(spin.poseJumpCount(), 0u);
 }
 
 TEST(SkeletonTracker, TeleportForOneFrameFlaggedCountedAndFollowed) {

@@ -107,12 +107,12 @@ TEST(StressJitter, GaussianOneToFiveCentimetres) {
     expectHealthy(s, name.c_str());
     if (sigma <= 0.02f) {
       EXPECT_LE(s.maxP99(kStart, end), control.maxP99(kStart, end) + 0.15f) << name << ": during the jitter";
-      expectRecovered(s, control, end, name.c_str());
     } else {
-      // 5 cm: bounded (measured worst frame 158 %), but not recovered one second later: see
-      // StressKnownIssues.DISABLED_RecoversFromFiveCentimetreJitter and docs/robustness.md.
+      // 5 cm: the tracker finds the noise and smooths harder (tracker.h, kNoiseReferenceM), but
+      // the body still shakes: measured worst frame P99 154 % during the jitter.
       EXPECT_LE(s.maxP99(kStart, end), 2.5f) << name << ": during the jitter";
     }
+    expectRecovered(s, control, end, name.c_str());
   }
 }
 
@@ -367,14 +367,11 @@ void loop(double minutes) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Known issues (docs/robustness.md, found by this suite; the cloth is another issue's work): the
-// run stays finite and bounded (asserted above or here), but does not come back to the
-// undisturbed stretch within a second. Run with --gtest_also_run_disabled_tests.
-
 // A skeleton flipped upside down for one second (every joint reflected through the pelvis), then
-// back. The pelvis does not move, so the tracker sees no teleport; the garment notices a pelvis
-// rotation no person makes in a frame and is placed on the new pose by ring skinning
-// (GarmentSim::poseJumped). Before that, particles reached 45 m/s, P99 332 %, no recovery.
+// back. The pelvis does not move, so it is no teleport; the tracker sees the raw torso turn
+// farther than a person can in a frame and restarts its filters (a pose jump, tracker.h), and the
+// garment, seeing its pelvis ring do the same, is placed on the new pose by ring skinning
+// (GarmentSim::poseJumped). Before both, particles reached 45 m/s, P99 332 %, no recovery.
 TEST(StressPose, UpsideDownSkeletonForOneSecondThenBack) {
   STRESS_REQUIRE_TAKE(take, kComeHere);
   const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
@@ -386,23 +383,10 @@ TEST(StressPose, UpsideDownSkeletonForOneSecondThenBack) {
     for (drape_joint& q : j) q.position = drape_vec3{2 * c.x - q.position.x, 2 * c.y - q.position.y, 2 * c.z - q.position.z};
   });
   print("upside-down skeleton", s);
-  // Measured: worst P99 65 % (the shirt hangs off the upside-down body), 4.8 m/s.
+  // Measured: worst P99 47 % while upside down (the shirt falls towards the head), 2.3 m/s.
   expectHealthy(s, "upside-down skeleton");
-  EXPECT_LE(s.maxP99(0, 1e9), 1.0f);
+  EXPECT_LE(s.maxP99(0, 1e9), 1.5f);
   expectRecovered(s, control, end, "upside-down skeleton");
-}
-
-// ---------------------------------------------------------------------------------------------
-// Known issue (docs/robustness.md): bounded and finite (asserted in StressJitter), but the
-// garment does not come back to the undisturbed stretch within a second. Run with
-// --gtest_also_run_disabled_tests.
-
-TEST(StressKnownIssues, DISABLED_RecoversFromFiveCentimetreJitter) {
-  STRESS_REQUIRE_TAKE(take, kComeHere);
-  const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
-  const Series control = replay(take, times);
-  const Series s = jittered(take, times, 0.05f, kStart + 2.0);
-  expectRecovered(s, control, kStart + 2.0, "jitter sigma 5 cm");
 }
 
 TEST(StressLoop, ReplayLoopTenMinutes) { loop(10.0); }

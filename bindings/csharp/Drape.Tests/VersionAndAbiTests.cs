@@ -243,6 +243,11 @@ namespace Drape.Tests
             ["drape_garment_stats"] = typeof(GarmentStats),
             ["drape_garment_accuracy"] = typeof(GarmentAccuracy),
             ["drape_recording_info"] = typeof(RecordingInfo),
+            ["drape_pipeline_options"] = typeof(PipelineOptions),
+            ["drape_skip_stats"] = typeof(SkipStats),
+            ["drape_backend_desc"] = typeof(BackendDesc),
+            ["drape_backend_info"] = typeof(BackendInfo),
+            ["drape_opencl_device"] = typeof(OpenClDeviceInfo),
         };
 
         private static Dictionary<string, string> HeaderStructBodies()
@@ -343,6 +348,8 @@ namespace Drape.Tests
             new object[] { "drape_solver", typeof(Solver) },
             new object[] { "drape_contact_response", typeof(ContactResponse) },
             new object[] { "drape_mesh_facing", typeof(MeshFacing) },
+            new object[] { "drape_pipeline_stage", typeof(PipelineStage) },
+            new object[] { "drape_backend", typeof(Backend) },
         };
 
         /// <summary>Every enumerator of the C enum (but *_FORCE32) has the C# member whose name, upper-cased,

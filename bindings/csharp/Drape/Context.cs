@@ -15,7 +15,7 @@ namespace Drape
     /// <para>The context owns its <see cref="Garment"/>s: disposing it destroys them and makes
     /// every later call on them throw <see cref="ObjectDisposedException"/>.</para>
     /// </summary>
-    public sealed unsafe class Context : IDisposable
+    public sealed unsafe partial class Context : IDisposable
     {
         private IntPtr _handle;
         private readonly List<Garment> _garments;

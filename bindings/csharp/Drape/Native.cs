@@ -201,6 +201,23 @@ namespace Drape
         [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
         internal static extern ResultCode drape_garment_measure(IntPtr garment, GarmentAccuracy* outAccuracy);
 
+        // ---- Adaptive pipeline (Pipeline.cs) ---------------------------------------------------
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_pipeline_options_init(PipelineOptions* options);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_set_pipeline_options(IntPtr context, PipelineOptions* options);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_get_pipeline_options(IntPtr context, PipelineOptions* outOptions);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_wake(IntPtr context);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_get_skip_stats(IntPtr context, SkipStats* outStats);
+
         // ---- Recordings ------------------------------------------------------------------------
 
         /// <param name="pathUtf8">NUL-terminated UTF-8 path (see Utf8.ToNative).</param>
@@ -229,6 +246,23 @@ namespace Drape
 
         [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
         internal static extern ResultCode drape_recording_save(IntPtr recording, byte* pathUtf8);
+
+        // ---- Backends --------------------------------------------------------------------------
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_backend_desc_init(BackendDesc* desc);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_set_backend(IntPtr context, BackendDesc* desc);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_get_backend_info(IntPtr context, BackendInfo* outInfo);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_opencl_device_count(uint* outCount);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_opencl_device_get(uint index, OpenClDeviceInfo* outDevice);
     }
 
     /// <summary>UTF-8 conversions for the C ABI's <c>const char*</c>, without any marshaller.</summary>

@@ -751,9 +751,11 @@ typedef struct drape_backend_info {
   uint32_t opencl_garments;        /* garments stepping on the device */
   uint32_t cpu_garments;           /* garments stepping on the CPU */
   uint32_t reserved;
-  char device_name[128];           /* the OpenCL device ("" without one), NUL-terminated */
-  char platform_name[128];
-  char fallback_reason[512];       /* why OpenCL was asked for and is not (fully) used, else "" */
+  /* UTF-8, never NULL, owned by the context: valid until the next
+   * drape_context_get_backend_info on this context or its destruction. */
+  const char* device_name;         /* the OpenCL device in use ("" without one) */
+  const char* platform_name;
+  const char* fallback_reason;     /* why OpenCL was asked for and is not (fully) used, else "" */
 } drape_backend_info;
 
 DRAPE_API drape_result DRAPE_CALL drape_context_get_backend_info(drape_context* context,
@@ -769,8 +771,8 @@ typedef struct drape_opencl_device {
   uint64_t local_mem_bytes;
   uint32_t compute_units;
   uint32_t reserved;
-  char platform_name[128];
-  char device_name[128];
+  const char* platform_name;       /* UTF-8, owned by the library, valid until the process ends */
+  const char* device_name;
 } drape_opencl_device;
 
 /* Number of OpenCL devices: 0 (DRAPE_OK) without an OpenCL driver or in a build without OpenCL. */

@@ -7,6 +7,8 @@
 #endif
 
 #include <cstring>
+#include <mutex>
+#include <set>
 #include <string>
 
 using drape::Context;
@@ -14,9 +16,20 @@ using drape::api::checkStructSize;
 using drape::api::fail;
 using drape::api::guarded;
 
+namespace {
+// Device names handed out by drape_opencl_device_get live until the process ends: each distinct
+// string is kept once (a handful per machine).
+const char* intern(const std::string& s) {
+  static std::mutex mutex;
+  static std::set<std::string> names;
+  std::lock_guard<std::mutex> lock(mutex);
+  return names.insert(s).first->c_str();
+}
+}  // namespace
+
 static_assert(sizeof(drape_backend_desc) == 24 + 2 * sizeof(void*), "drape_backend_desc layout");
-static_assert(sizeof(drape_backend_info) == 24 + 128 + 128 + 512, "drape_backend_info layout");
-static_assert(sizeof(drape_opencl_device) == 40 + 256, "drape_opencl_device layout");
+static_assert(sizeof(drape_backend_info) == 24 + 3 * sizeof(void*), "drape_backend_info layout");
+static_assert(sizeof(drape_opencl_device) == 40 + 2 * sizeof(void*), "drape_opencl_device layout");
 
 DRAPE_API drape_result DRAPE_CALL drape_backend_desc_init(drape_backend_desc* desc) {
   if (!desc) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_backend_desc_init: desc is NULL");
@@ -96,8 +109,8 @@ DRAPE_API drape_result DRAPE_CALL drape_opencl_device_get(uint32_t index, drape_
     o.global_mem_bytes = d.global_mem;
     o.local_mem_bytes = d.local_mem;
     o.compute_units = d.compute_units;
-    std::strncpy(o.platform_name, d.platform_name.c_str(), sizeof(o.platform_name) - 1);
-    std::strncpy(o.device_name, d.device_name.c_str(), sizeof(o.device_name) - 1);
+    o.platform_name = intern(d.platform_name);
+    o.device_name = intern(d.device_name);
     *out = o;
     return DRAPE_OK;
 #else

@@ -66,7 +66,8 @@ class Context {
   // Backends (docs/opencl.md; capi/context_backend.cpp). desc validated by the caller. Moves every
   // garment to the chosen backend; OpenCL trouble falls back to the CPU with the reason kept.
   drape_result setBackend(const drape_backend_desc& desc, std::string& err);
-  void backendInfo(drape_backend_info& out) const;
+  // The strings point into the context, valid until the next call.
+  void backendInfo(drape_backend_info& out);
   void fillStats(drape_frame_stats& out);
 
   // The adaptive pipeline (capi/adaptive.h, docs/adaptive.md). Options must be valid.
@@ -110,6 +111,7 @@ class Context {
   // garments whose device failed back to the CPU.
   struct Backend;
   std::shared_ptr<Backend> backend_;
+  std::string infoDevice_, infoPlatform_, infoReason_;  // backendInfo() strings
   void applyBackend(GarmentSim& garment);
   void checkDeviceFailures();
 

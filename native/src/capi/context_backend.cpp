@@ -46,11 +46,6 @@ std::shared_ptr<ClRuntime> sharedRuntime(const drape_backend_desc& d, std::strin
 }
 #endif
 
-void copyName(char* out, size_t size, const std::string& s) {
-  const size_t n = std::min(size - 1, s.size());
-  std::memcpy(out, s.data(), n);
-  out[n] = '\0';
-}
 
 }  // namespace
 
@@ -106,8 +101,11 @@ void Context::checkDeviceFailures() {
   }
 }
 
-void Context::backendInfo(drape_backend_info& o) const {
+void Context::backendInfo(drape_backend_info& o) {
   std::memset(&o, 0, sizeof(o));
+  infoDevice_.clear();
+  infoPlatform_.clear();
+  infoReason_.clear();
   o.struct_size = sizeof(o);
   o.requested = backend_ ? backend_->desc.backend : DRAPE_BACKEND_CPU;
   for (const auto& g : garments_) {
@@ -115,16 +113,22 @@ void Context::backendInfo(drape_backend_info& o) const {
     else ++o.cpu_garments;
   }
   o.active = o.opencl_garments > 0 ? DRAPE_BACKEND_OPENCL : DRAPE_BACKEND_CPU;
+  o.device_name = infoDevice_.c_str();
+  o.platform_name = infoPlatform_.c_str();
+  o.fallback_reason = infoReason_.c_str();
   if (!backend_) return;
 #if DRAPE_HAVE_OPENCL
   if (backend_->runtime) {
-    copyName(o.device_name, sizeof(o.device_name), backend_->runtime->deviceName());
-    copyName(o.platform_name, sizeof(o.platform_name), backend_->runtime->platformName());
+    infoDevice_ = backend_->runtime->deviceName();
+    infoPlatform_ = backend_->runtime->platformName();
     // An OpenCL request with a working device and no garment yet counts as OpenCL.
     if (garments_.empty() && backend_->desc.backend == DRAPE_BACKEND_OPENCL) o.active = DRAPE_BACKEND_OPENCL;
   }
 #endif
-  copyName(o.fallback_reason, sizeof(o.fallback_reason), backend_->reason);
+  infoReason_ = backend_->reason;
+  o.device_name = infoDevice_.c_str();  // re-read: the strings changed
+  o.platform_name = infoPlatform_.c_str();
+  o.fallback_reason = infoReason_.c_str();
 }
 
 }  // namespace drape

@@ -94,6 +94,12 @@ void SkeletonTracker::reset() {
   have_pelvis_ = false;
   last_pelvis_ = Vec3::Zero();
   last_pelvis_t_ = 0.0;
+  noise_seen_.fill(0);
+  noise_dt1_ = 0.0f;
+  noise_var_ = 0.0f;
+  have_torso_ = false;
+  pose_jumped_ = false;
+  pose_jumps_ = 0;
   teleported_ = false;
   teleports_ = 0;
 }
@@ -133,7 +139,7 @@ Vec3 SkeletonTracker::filterJoint(int j, const Vec3& x, bool inferred, float dt)
     const float betaScale = inferred ? kInferredBetaScale : 1.0f;
     const Vec3 v = (x - f.raw) / h;
     f.dx += alphaFor(p_.d_cutoff_hz, h) * (v - f.dx);
-    const float cutoff = cutoffScale * p_.min_cutoff_hz + betaScale * p_.beta * f.dx.norm();
+    const float cutoff = cutoffScale * p_.min_cutoff_hz + betaScale * effectiveBeta() * f.dx.norm();
     f.x += alphaFor(cutoff, h) * (x - f.x);
     f.raw = x;
     return f.x;
@@ -162,6 +168,81 @@ Vec3 SkeletonTracker::filterJoint(int j, const Vec3& x, bool inferred, float dt)
   const float dev = (predicted - x).norm();
   if (dev > maxDev) predicted = x + (predicted - x) * (maxDev / dev);
   return predicted;
+}
+
+float SkeletonTracker::noiseSigmaM() const { return std::sqrt(noise_var_); }
+
+float SkeletonTracker::effectiveBeta() const {
+  return p_.beta / (1.0f + noise_var_ / (kNoiseReferenceM * kNoiseReferenceM));
+}
+
+bool SkeletonTracker::poseJumpedLastPush() const { return pose_jumped_; }
+uint32_t SkeletonTracker::poseJumpCount() const { return pose_jumps_; }
+
+bool SkeletonTracker::rawTorsoFrame(const SkeletonPose& raw, const std::array<TrackingState, kJointCount>& st,
+                                    Mat3& out) const {
+  const int pelvis = idx(Joint::Pelvis), chest = idx(Joint::SpineShoulder);
+  const int hl = idx(Joint::HipL), hr = idx(Joint::HipR);
+  const int sl = idx(Joint::ShoulderL), sr = idx(Joint::ShoulderR);
+  for (int j : {pelvis, chest, hl, hr, sl, sr})
+    if (st[j] != TrackingState::Tracked) return false;
+  // Hips and shoulders together: a baseline of ~0.6 m, so centimetres of sensor noise turn it by
+  // a few degrees only.
+  const Vec3 up = raw.position[chest] - raw.position[pelvis];
+  const Vec3 side = raw.position[hr] - raw.position[hl] + raw.position[sr] - raw.position[sl];
+  if (!(up.norm() > 0.05f) || !(side.norm() > 0.02f)) return false;
+  const Vec3 y = up.normalized();
+  const Vec3 z = side.cross(y);
+  if (!(z.norm() > 1e-3f * side.norm())) return false;  // hips along the spine: no frame
+  out.col(1) = y;
+  out.col(2) = z.normalized();
+  out.col(0) = y.cross(out.col(2));
+  return out.allFinite();
+}
+
+namespace {
+constexpr float kNoiseJumpFactor = 4.0f;
+constexpr float kNoiseFloorM = 0.03f;
+}  // namespace
+
+void SkeletonTracker::estimateNoise(const SkeletonPose& raw, const std::array<TrackingState, kJointCount>& st,
+                                    float dt) {
+  static constexpr std::array<Joint, kNoiseJoints> kTorso = {Joint::Pelvis, Joint::SpineMid, Joint::SpineShoulder,
+                                                            Joint::ShoulderL, Joint::ShoulderR, Joint::HipL,
+                                                            Joint::HipR};
+  // Each joint's deviation from the straight line through its two previous samples,
+  // e = x - x1 - (x1 - x2) r with r = dt / dt1. For white noise of variance s^2 per coordinate,
+  // E|e|^2 = 3 s^2 (1 + (1 + r)^2 + r^2). The median over the torso joints is one sample; an
+  // exponential average over kNoiseTimeConstantS smooths them.
+  std::array<float, kNoiseJoints> v{};
+  int n = 0;
+  const float r = noise_dt1_ > 0.0f ? std::clamp(dt / noise_dt1_, 0.1f, 10.0f) : 1.0f;
+  for (int k = 0; k < kNoiseJoints; ++k) {
+    const int j = idx(kTorso[static_cast<size_t>(k)]);
+    if (st[j] != TrackingState::Tracked) {
+      noise_seen_[static_cast<size_t>(k)] = 0;
+      continue;
+    }
+    const Vec3& x = raw.position[j];
+    const size_t kk = static_cast<size_t>(k);
+    if (noise_seen_[kk] >= 2) {
+      const Vec3 e = x - noise_x1_[kk] - (noise_x1_[kk] - noise_x2_[kk]) * r;
+      v[static_cast<size_t>(n++)] = e.squaredNorm() / (3.0f * (1.0f + (1.0f + r) * (1.0f + r) + r * r));
+    }
+    noise_x2_[kk] = noise_x1_[kk];
+    noise_x1_[kk] = x;
+    noise_seen_[kk] = std::min(noise_seen_[kk] + 1, 2);
+  }
+  noise_dt1_ = dt;
+  if (n == 0) return;
+  std::nth_element(v.begin(), v.begin() + n / 2, v.begin() + n);
+  // A jump (a skeleton flipped for a frame, a joint snapping to another place) is no noise: one
+  // sample may raise the estimate only so far (kNoiseJumpFactor times it, or (kNoiseFloorM)^2).
+  const float cap = std::max(kNoiseJumpFactor * noise_var_, kNoiseFloorM * kNoiseFloorM);
+  const float sample = std::min(v[static_cast<size_t>(n / 2)], cap);
+  if (!std::isfinite(sample)) return;
+  const float a = 1.0f - std::exp(-std::max(dt, kMinFilterDt) / kNoiseTimeConstantS);
+  noise_var_ += a * (sample - noise_var_);
 }
 
 void SkeletonTracker::collectCalibration(const SkeletonPose& raw) {
@@ -244,9 +325,31 @@ void SkeletonTracker::push(const SkeletonPose& raw, double time_s) {
     last_pelvis_ = pelvis;
     last_pelvis_t_ = t;
   }
+  // Pose jump: the raw torso turned farther since the last push than a person turns in dt (a
+  // skeleton flipped upside down, front and back swapped). Like a teleport, the filters restart
+  // so the output lands on the new pose at once instead of sweeping through the poses between.
+  pose_jumped_ = false;
+  Mat3 torso;
+  if (rawTorsoFrame(raw, st, torso)) {
+    if (have_torso_) {
+      const Mat3 R = torso * last_torso_.transpose();
+      const float c = std::clamp(0.5f * (R.trace() - 1.0f), -1.0f, 1.0f);
+      const float gap = static_cast<float>(std::clamp(t - last_torso_t_, 0.0, static_cast<double>(kMaxFilterGapS)));
+      if (std::acos(c) > kPoseJumpRad + kMaxTurnRadPerS * gap) {
+        pose_jumped_ = true;
+        ++pose_jumps_;
+        restart = true;
+      }
+    }
+    have_torso_ = true;
+    last_torso_ = torso;
+    last_torso_t_ = t;
+  }
   if (restart) {
     for (JointFilter& f : filt_) f.frames = 0;
+    noise_seen_.fill(0);  // the noise estimate skips the jump (no straight line spans it)
   }
+  estimateNoise(raw, st, dt);
 
   collectCalibration(raw);
   if (pushes_ < std::numeric_limits<int>::max()) ++pushes_;

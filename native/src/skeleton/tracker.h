@@ -41,6 +41,17 @@ constexpr float kInferredBetaScale = 0.1f;
 // ... and the double exponential jitter radius / max deviation are multiplied by this (as the
 // Kinect SDK's own sample filter does).
 constexpr float kInferredRadiusScale = 2.0f;
+// Sensor noise: estimated from the torso joints (which never accelerate much, so what their
+// positions do beyond a straight line is noise) over kNoiseTimeConstantS. The One-Euro beta is
+// divided by 1 + (noise / kNoiseReferenceM)^2: on a noisy sensor the filter stops chasing what its
+// derivative estimate calls speed but is noise (docs/skeleton.md, "Sensor noise").
+constexpr float kNoiseTimeConstantS = 0.5f;
+// A raw torso (pelvis, spine-shoulder, hips, shoulders) turning beyond kPoseJumpRad +
+// kMaxTurnRadPerS * dt between two pushes is a pose jump: no person turns that fast (a pirouette
+// is ~2 turns a second); 90 degrees on top keeps 5 cm of sensor noise from looking like one.
+constexpr float kPoseJumpRad = 1.5708f;
+constexpr float kMaxTurnRadPerS = 12.566f;
+constexpr float kNoiseReferenceM = 0.015f;
 
 class SkeletonTracker {
  public:
@@ -54,6 +65,13 @@ class SkeletonTracker {
   bool calibrated() const;           // bone lengths frozen
   const std::array<float, kBoneCount>& boneLengths() const;  // current (calibrating: running estimate) lengths
   bool teleportedLastPush() const;
+  // The last push's raw torso turned farther than a person can in its dt (filters restarted).
+  bool poseJumpedLastPush() const;
+  uint32_t poseJumpCount() const;
+  // Estimated sensor noise (standard deviation per coordinate, metres) and the One-Euro beta in
+  // use because of it.
+  float noiseSigmaM() const;
+  float effectiveBeta() const;
   uint32_t teleportCount() const;
   const TrackerParams& params() const;  // as used: out-of-range values replaced (docs/skeleton.md)
 
@@ -67,6 +85,9 @@ class SkeletonTracker {
 
   Vec3 filterJoint(int j, const Vec3& x, bool inferred, float dt);
   void collectCalibration(const SkeletonPose& raw);
+  // Frame of the raw torso (columns: right, up, forward-ish); false when a joint is not tracked.
+  bool rawTorsoFrame(const SkeletonPose& raw, const std::array<TrackingState, kJointCount>& st, Mat3& out) const;
+  void estimateNoise(const SkeletonPose& raw, const std::array<TrackingState, kJointCount>& st, float dt);
   void updateLengths(const SkeletonPose& raw);
   float medianOf(const float* v, int n);
 
@@ -97,6 +118,20 @@ class SkeletonTracker {
   double last_pelvis_t_ = 0.0;
   bool teleported_ = false;
   uint32_t teleports_ = 0;
+
+  // Sensor noise estimate (estimateNoise): the torso joints' last two raw samples.
+  static constexpr int kNoiseJoints = 7;
+  std::array<Vec3, kNoiseJoints> noise_x1_{}, noise_x2_{};
+  std::array<int, kNoiseJoints> noise_seen_{};  // consecutive tracked samples, capped at 2
+  float noise_dt1_ = 0.0f;                      // dt between noise_x2_ and noise_x1_
+  float noise_var_ = 0.0f;                      // per-coordinate variance, m^2
+
+  // Pose jumps: the raw torso frame of the last push that had one.
+  bool have_torso_ = false;
+  Mat3 last_torso_ = Mat3::Identity();
+  double last_torso_t_ = 0.0;
+  bool pose_jumped_ = false;
+  uint32_t pose_jumps_ = 0;
 };
 
 }  // namespace drape

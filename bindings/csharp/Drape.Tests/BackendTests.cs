@@ -1,0 +1,83 @@
+using System;
+using Xunit;
+
+namespace Drape.Tests
+{
+    /// <summary>The Backends section through C#: defaults, the device list, a rejected desc, the
+    /// fallback with its reason, and a garment stepping on OpenCL when the machine has a device
+    /// (PoCL in CI). docs/opencl.md.</summary>
+    public class BackendTests
+    {
+        public BackendTests() => TestEnvironment.RequireNativeLibrary();
+
+        private static void StepFrames(Context ctx, int count)
+        {
+            for (int i = 0; i < count; ++i)
+            {
+                ctx.PushSkeleton(SyntheticKinect2.Frame(i), Layout.Kinect2, SyntheticKinect2.Time(i));
+                ctx.Step(1.0f / 30.0f);
+            }
+        }
+
+        [Fact]
+        public void DefaultsAndCpuStart()
+        {
+            BackendDesc d = BackendDesc.CreateDefault();
+            Assert.Equal(Backend.Cpu, d.Backend);
+            Assert.Equal(-1, d.PlatformIndex);
+            Assert.Equal(-1, d.DeviceIndex);
+            Assert.Equal(1u, d.PreferGpu);
+            Assert.Equal(2000u, d.OpenclMinParticles);
+            using var ctx = new Context();
+            BackendStatus s = ctx.GetBackendInfo();
+            Assert.Equal(Backend.Cpu, s.Active);
+            Assert.Equal("", s.FallbackReason);
+        }
+
+        [Fact]
+        public void BadDescIsRejected()
+        {
+            using var ctx = new Context();
+            BackendDesc d = BackendDesc.CreateDefault();
+            d.Backend = (Backend)7;
+            var e = Assert.Throws<DrapeException>(() => ctx.SetBackend(d));
+            Assert.Equal(ResultCode.OutOfRange, e.Code);
+            Assert.Equal(Backend.Cpu, ctx.GetBackendInfo().Requested);
+        }
+
+        [Fact]
+        public void ImpossibleDeviceFallsBackToTheCpu()
+        {
+            using var ctx = new Context();
+            BackendDesc d = BackendDesc.CreateDefault();
+            d.Backend = Backend.OpenCl;
+            d.DeviceIndex = 250;
+            ctx.SetBackend(d);
+            BackendStatus s = ctx.GetBackendInfo();
+            Assert.Equal(Backend.OpenCl, s.Requested);
+            Assert.Equal(Backend.Cpu, s.Active);
+            Assert.NotEqual("", s.FallbackReason);
+        }
+
+        [Fact]
+        public void GarmentStepsOnOpenClWhenADeviceExists()
+        {
+            var devices = OpenCl.Devices();
+            foreach (OpenClDevice dev in devices) Assert.NotEqual("", dev.DeviceName);
+            if (devices.Count == 0) return;  // no OpenCL driver: nothing more to check here
+            using var ctx = new Context();
+            GarmentTemplate t = GarmentTemplate.CreateDefault(GarmentKind.TShirt);
+            t.Particles = 400;
+            Garment g = ctx.AddGarment(t);
+            BackendDesc d = BackendDesc.CreateDefault();
+            d.Backend = Backend.OpenCl;
+            ctx.SetBackend(d);
+            BackendStatus s = ctx.GetBackendInfo();
+            if (s.Active != Backend.OpenCl) return;  // the device could not build the kernels: reason in s
+            Assert.Equal(1, s.OpenClGarments);
+            Assert.NotEqual("", s.DeviceName);
+            StepFrames(ctx, 4);
+            Assert.True(g.Stats.Contacts > 0);
+        }
+    }
+}
