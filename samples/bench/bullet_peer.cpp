@@ -13,6 +13,8 @@
 #include <cmath>
 #include <memory>
 
+#include <time.h>
+
 namespace bench {
 
 namespace {
@@ -22,6 +24,14 @@ using Clock = std::chrono::steady_clock;
 struct ContextDeleter {
   void operator()(drape_context* c) const { drape_context_destroy(c); }
 };
+
+// CPU time of this thread, ms: on a shared machine a 50 ms Bullet step is preempted far more often
+// than a 1 ms Drape step, so wall time would favour Drape; both engines run on this thread only.
+double threadCpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
+}
 
 btVector3 bt(const drape_vec3& v) { return btVector3(v.x, v.y, v.z); }
 
@@ -91,13 +101,15 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
   out.particles = nv;
   std::vector<uint32_t> indices(ni), body_idx(body_ni);
   std::vector<drape_vec3> rest(nv), x(nv), body(body_nv), bx(nv);
-  if (!ok("drape_garment_read_mesh", drape_garment_read_mesh(garment, nullptr, nullptr, 0, indices.data(), ni), error) ||
+  if (!ok("drape_garment_read_mesh", drape_garment_read_mesh(garment, nullptr, nullptr, 0, indices.data(), ni),
+          error) ||
       !ok("drape_garment_read_rest_positions", drape_garment_read_rest_positions(garment, rest.data(), nv), error) ||
-      !ok("drape_context_read_body_mesh", drape_context_read_body_mesh(ctx.get(), nullptr, nullptr, 0, body_idx.data(), body_ni), error))
+      !ok("drape_context_read_body_mesh",
+          drape_context_read_body_mesh(ctx.get(), nullptr, nullptr, 0, body_idx.data(), body_ni), error))
     return false;
   std::vector<drape_ellipsoid> e_start(ne), e_end(ne);
 
-  auto pushStep = [&](size_t i, double& frame_ms, double& cloth_ms) -> bool {
+  auto pushStep = [&](size_t i, double& frame_ms, double& cloth_ms, double& cpu_ms) -> bool {
     drape_skeleton_frame f{};
     f.struct_size = sizeof f;
     f.layout = take.layout;
@@ -106,23 +118,28 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
     f.joints = take.frames[i].data();
     const double dt = i == 0 ? 1.0 / take.rate_hz : take.timestamps_s[i] - take.timestamps_s[i - 1];
     const Clock::time_point t0 = Clock::now();
-    if (drape_result r = drape_context_push_skeleton(ctx.get(), &f)) return failed("drape_context_push_skeleton", r, error);
+    const double c0 = threadCpuMs();
+    if (drape_result r = drape_context_push_skeleton(ctx.get(), &f))
+      return failed("drape_context_push_skeleton", r, error);
     if (drape_result r = drape_context_step(ctx.get(), static_cast<float>(std::min(std::max(dt, 1e-4), 1.0))))
       return failed("drape_context_step", r, error);
+    cpu_ms = threadCpuMs() - c0;
     frame_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     drape_garment_stats gs{};
     gs.struct_size = sizeof gs;
     uint32_t count = 0;
     if (!ok("drape_garment_get_stats", drape_garment_get_stats(garment, &gs), error) ||
-        !ok("drape_context_read_ellipsoids", drape_context_read_ellipsoids(ctx.get(), e_end.data(), ne, &count), error) ||
+        !ok("drape_context_read_ellipsoids", drape_context_read_ellipsoids(ctx.get(), e_end.data(), ne, &count),
+            error) ||
         !ok("drape_garment_read_mesh", drape_garment_read_mesh(garment, x.data(), nullptr, nv, nullptr, 0), error) ||
-        !ok("drape_context_read_body_mesh", drape_context_read_body_mesh(ctx.get(), body.data(), nullptr, body_nv, nullptr, 0), error))
+        !ok("drape_context_read_body_mesh",
+            drape_context_read_body_mesh(ctx.get(), body.data(), nullptr, body_nv, nullptr, 0), error))
       return false;
     cloth_ms = gs.step_ms;
     return true;
   };
-  double frame_ms = 0, cloth_ms = 0;
-  if (!pushStep(0, frame_ms, cloth_ms)) return false;
+  double frame_ms = 0, cloth_ms = 0, cpu_ms = 0;
+  if (!pushStep(0, frame_ms, cloth_ms, cpu_ms)) return false;
   std::vector<uint8_t> pinned(nv, 0);
   {
     const float* xyzw = nullptr;
@@ -193,9 +210,10 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
     e_start = e_end;
     for (uint32_t k = 0; k < nv; ++k)
       if (pinned[k]) pin_start[k] = x[k];
-    if (!pushStep(i, frame_ms, cloth_ms)) return false;
+    if (!pushStep(i, frame_ms, cloth_ms, cpu_ms)) return false;
     out.drape.ms.push_back(cloth_ms);
     out.drape.frame_ms.push_back(frame_ms);
+    out.drape.cpu_ms.push_back(cpu_ms);
     const double dt = take.timestamps_s[i] - take.timestamps_s[i - 1];
     const int n = std::max(1, static_cast<int>(std::lround(dt * rate)));
     const btScalar h = static_cast<btScalar>(dt / n);
@@ -210,6 +228,7 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
       }
     }
     const Clock::time_point t0 = Clock::now();
+    const double c0 = threadCpuMs();
     if (rescaled) info.m_sparsesdf.Reset();
     for (int s = 0; s < n; ++s) {
       const btScalar t = static_cast<btScalar>(s + 1) / static_cast<btScalar>(n);
@@ -231,6 +250,7 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
       }
       w.world.stepSimulation(h, 0, h);
     }
+    out.bullet.cpu_ms.push_back(threadCpuMs() - c0);
     out.bullet.ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
     for (uint32_t k = 0; k < nv; ++k) {
       const btVector3& p = sb.m_nodes[static_cast<int>(k)].m_x;

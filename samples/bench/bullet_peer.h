@@ -9,8 +9,9 @@
 // mass: 0.2 kg/m^2), its attached nodes as kinematic nodes moved to the same targets across the
 // substeps, each tracking ellipsoid as a kinematic btMultiSphereShape (one unit sphere, scaled by
 // the radii) moved across the substeps, gravity, 4 mm collision margin (Drape's), `substeps` fixed
-// substeps per 1/60 s and `iterations` position iterations. Only btSoftRigidDynamicsWorld::
-// stepSimulation is timed for Bullet; Drape's cloth step in the same frame is timed beside it.
+// substeps per 1/60 s and `iterations` position iterations. Bullet: its stepSimulation calls are
+// timed; Drape: its whole frame (push + step: skeleton, body, proxies, cloth) beside it, in the
+// same frame; both in thread CPU time (and wall time).
 // Both garments are measured by the same meters (metrics.h) on the same frames (all but the first).
 #pragma once
 
@@ -22,8 +23,11 @@
 namespace bench {
 
 struct PeerSide {
-  std::vector<double> ms;  // per frame: Bullet's stepSimulation / Drape's garment step (cloth only)
+  std::vector<double> ms;        // per frame: Bullet's stepSimulation / Drape's garment step (cloth only)
   std::vector<double> frame_ms;  // Drape only: push + whole step (skeleton, body, proxies, cloth)
+  // Thread CPU time per frame: Bullet's stepSimulation calls; Drape's push + whole step. The
+  // ratio is taken from these (wall time on a shared machine penalises the longer step).
+  std::vector<double> cpu_ms;
   double stretch_p99 = 0, stretch_max = 0;
   double penetration_p99_mm = 0, penetration_max_mm = 0, deeper_than_2mm = 0;
   double inside_mean = 0;  // free vertices inside any tracking ellipsoid, per frame

@@ -47,8 +47,8 @@ bool energyDrift(const Setting& s, double seconds, EnergyDrift& out, std::string
   drape::TopologyParams topo;  // the library's defaults, as drape_garment_desc_init gives them
   topo.pinned = mesh.pinned;
   drape::GarmentTopology t;
-  if (!drape::buildGarmentTopology(xyz.data(), mesh.positions.size(), mesh.indices.data(), mesh.indices.size(), topo,
-                                   t, error))
+  if (!drape::buildGarmentTopology(xyz.data(), mesh.positions.size(), mesh.indices.data(), mesh.indices.size(), topo, t,
+                                   error))
     return false;
   double mass = 0.0, lo = 1e30, hi = -1e30;
   for (size_t i = 0; i < t.particleCount(); ++i) {

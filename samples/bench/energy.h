@@ -21,9 +21,9 @@
 namespace bench {
 
 struct EnergyDrift {
-  double drift = 0;         // (E(T) - E(0)) / (M g H)
-  double worst = 0;         // the largest |E(t) - E(0)| / (M g H) over the frames
-  bool exploded = false;    // the mass-spring solver reported an explosion
+  double drift = 0;       // (E(T) - E(0)) / (M g H)
+  double worst = 0;       // the largest |E(t) - E(0)| / (M g H) over the frames
+  bool exploded = false;  // the mass-spring solver reported an explosion
 };
 
 // Uses drape's internal C++ (drape_core): the C ABI exposes neither velocities nor masses.

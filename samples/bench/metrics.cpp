@@ -29,9 +29,7 @@ double mean(const std::vector<double>& v) {
   return s / static_cast<double>(v.size());
 }
 
-double maximum(const std::vector<double>& v) {
-  return v.empty() ? kNaN : *std::max_element(v.begin(), v.end());
-}
+double maximum(const std::vector<double>& v) { return v.empty() ? kNaN : *std::max_element(v.begin(), v.end()); }
 
 bool PenetrationMeter::setBody(const std::vector<drape_vec3>& positions, const std::vector<uint32_t>& indices) {
   scratch_.resize(positions.size());

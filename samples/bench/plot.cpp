@@ -30,9 +30,8 @@ std::string quoted(const std::string& s) {
 std::vector<size_t> paretoFront(const std::vector<double>& time, const std::vector<double>& error) {
   std::vector<size_t> order(time.size());
   std::iota(order.begin(), order.end(), size_t{0});
-  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-    return time[a] != time[b] ? time[a] < time[b] : error[a] < error[b];
-  });
+  std::sort(order.begin(), order.end(),
+            [&](size_t a, size_t b) { return time[a] != time[b] ? time[a] < time[b] : error[a] < error[b]; });
   std::vector<size_t> front;
   double best = INFINITY;
   for (size_t i : order) {
@@ -45,8 +44,8 @@ std::vector<size_t> paretoFront(const std::vector<double>& time, const std::vect
   return front;
 }
 
-bool plotSweep(const std::string& dir, const std::string& stem, const std::string& title,
-               const std::vector<Row>& rows, std::string& note) {
+bool plotSweep(const std::string& dir, const std::string& stem, const std::string& title, const std::vector<Row>& rows,
+               std::string& note) {
   const std::string dat = dir + "/" + stem + ".dat", gp = dir + "/" + stem + ".gp", png = dir + "/" + stem + ".png";
   // One block per take (gnuplot index), each with: time, deviation, penetration, default flag, label;
   // then per take the two Pareto fronts.

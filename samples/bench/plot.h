@@ -16,7 +16,7 @@ std::vector<size_t> paretoFront(const std::vector<double>& time, const std::vect
 
 // Writes <dir>/<stem>.dat and <stem>.gp and runs gnuplot (found on PATH) to draw <stem>.png.
 // Returns false with `note` set when gnuplot is missing or failed (the .gp script is kept).
-bool plotSweep(const std::string& dir, const std::string& stem, const std::string& title,
-               const std::vector<Row>& rows, std::string& note);
+bool plotSweep(const std::string& dir, const std::string& stem, const std::string& title, const std::vector<Row>& rows,
+               std::string& note);
 
 }  // namespace bench

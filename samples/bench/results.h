@@ -18,6 +18,7 @@ struct StageTime {
 struct Row {
   Setting setting;
   std::string take;
+  std::string device;  // OpenCL device and platform, when that backend ran
   double rate_hz = 0;
   uint32_t particles = 0;
   size_t timed_frames = 0;  // pooled over the repeats

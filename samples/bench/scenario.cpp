@@ -89,6 +89,8 @@ Setting Setting::reference() const {
   r.is_default = false;
   r.substep_hz = std::min(16.0f * substep_hz, 20000.0f);
   if (solver == DRAPE_SOLVER_XPBD) r.iterations = std::min<uint32_t>(4 * iterations, 64);
+  // The backends compute the same step (within float rounding): one CPU reference serves all.
+  r.backend = "cpu";
   return r;
 }
 
@@ -133,8 +135,14 @@ bool runDrape(const Take& take, const Setting& s, const RunOptions& o, RunResult
     return false;
   }
   std::unique_ptr<drape_context, ContextDeleter> ctx(raw);
-  if (s.backend != "cpu") {
-    error = "backend '" + s.backend + "' is not available in this build";
+  if (s.backend == "opencl") {
+    drape_backend_desc bd;
+    drape_backend_desc_init(&bd);
+    bd.backend = DRAPE_BACKEND_OPENCL;
+    if (drape_result r = drape_context_set_backend(ctx.get(), &bd))
+      return failed("drape_context_set_backend", r, error);
+  } else if (s.backend != "cpu") {
+    error = "unknown backend '" + s.backend + "'";
     return false;
   }
   drape_garment_desc gdesc;
@@ -158,6 +166,21 @@ bool runDrape(const Take& take, const Setting& s, const RunOptions& o, RunResult
     error = libraryError("drape_context_add_garment_template", r);
     return false;
   }
+  if (s.backend == "opencl") {
+    // Asking for OpenCL falls back to the CPU when no device works: a CPU run must not be
+    // reported as an OpenCL one.
+    drape_backend_info bi{};
+    bi.struct_size = sizeof bi;
+    if (drape_result r = drape_context_get_backend_info(ctx.get(), &bi))
+      return failed("drape_context_get_backend_info", r, error);
+    if (bi.active != DRAPE_BACKEND_OPENCL || bi.opencl_garments != 1) {
+      error =
+          std::string("OpenCL is not in use (") + (bi.fallback_reason ? bi.fallback_reason : "no reason given") + ")";
+      return false;
+    }
+    out.device =
+        std::string(bi.device_name ? bi.device_name : "") + " (" + (bi.platform_name ? bi.platform_name : "") + ")";
+  }
   uint32_t nv = 0, ni = 0;
   if (drape_result r = drape_garment_get_mesh_size(garment, &nv, &ni)) {
     error = libraryError("drape_garment_get_mesh_size", r);
@@ -167,13 +190,16 @@ bool runDrape(const Take& take, const Setting& s, const RunOptions& o, RunResult
   out.indices.resize(ni);
   out.rest.resize(nv);
   uint32_t body_nv = 0, body_ni = 0;
-  if (!ok("drape_garment_read_mesh", drape_garment_read_mesh(garment, nullptr, nullptr, 0, out.indices.data(), ni), error) ||
-      !ok("drape_garment_read_rest_positions", drape_garment_read_rest_positions(garment, out.rest.data(), nv), error) ||
+  if (!ok("drape_garment_read_mesh", drape_garment_read_mesh(garment, nullptr, nullptr, 0, out.indices.data(), ni),
+          error) ||
+      !ok("drape_garment_read_rest_positions", drape_garment_read_rest_positions(garment, out.rest.data(), nv),
+          error) ||
       !ok("drape_context_get_body_mesh_size", drape_context_get_body_mesh_size(ctx.get(), &body_nv, &body_ni), error))
     return false;
   std::vector<drape_vec3> body(body_nv);
   std::vector<uint32_t> body_idx(body_ni);
-  if (!ok("drape_context_read_body_mesh", drape_context_read_body_mesh(ctx.get(), nullptr, nullptr, 0, body_idx.data(), body_ni), error))
+  if (!ok("drape_context_read_body_mesh",
+          drape_context_read_body_mesh(ctx.get(), nullptr, nullptr, 0, body_idx.data(), body_ni), error))
     return false;
 
   PenetrationMeter pen;
@@ -211,8 +237,8 @@ bool runDrape(const Take& take, const Setting& s, const RunOptions& o, RunResult
     substeps.push_back(gs.substeps);
     // The first frame (pose blended in over extra frames) and teleports are not steady frames.
     if (gs.blend_frames == 0 && !gs.teleport_reset)
-      out.times.push_back({frame_ms, fs.skeleton_ms, fs.body_ms, fs.proxies_ms, gs.step_ms, gs.integrate_ms,
-                           gs.collide_ms});
+      out.times.push_back(
+          {frame_ms, fs.skeleton_ms, fs.body_ms, fs.proxies_ms, gs.step_ms, gs.integrate_ms, gs.collide_ms});
     if (!o.measure && !o.keep_positions) continue;
     if (drape_result r = drape_garment_read_mesh(garment, x.data(), nullptr, nv, nullptr, 0)) {
       error = libraryError("drape_garment_read_mesh", r);
@@ -230,7 +256,8 @@ bool runDrape(const Take& take, const Setting& s, const RunOptions& o, RunResult
     drape_garment_accuracy acc{};
     acc.struct_size = sizeof acc;
     if (!ok("drape_garment_measure", drape_garment_measure(garment, &acc), error) ||
-        !ok("drape_context_read_body_mesh", drape_context_read_body_mesh(ctx.get(), body.data(), nullptr, body_nv, nullptr, 0), error))
+        !ok("drape_context_read_body_mesh",
+            drape_context_read_body_mesh(ctx.get(), body.data(), nullptr, body_nv, nullptr, 0), error))
       return false;
     inside.push_back(acc.proxy_inside);
     out.inside_max = std::max(out.inside_max, acc.proxy_inside);

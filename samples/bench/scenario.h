@@ -14,7 +14,7 @@ namespace bench {
 // A real recording, replayed at `rate_hz` (every `stride`-th frame; the 120 Hz BVH takes at 60 Hz
 // so that a frame is the 1/60 s the Bullet and NvCloth figures are quoted for).
 struct Take {
-  std::string name;   // short name for tables (file stem)
+  std::string name;  // short name for tables (file stem)
   std::string path;
   int32_t layout = 0;
   uint32_t joint_count = 0;
@@ -45,7 +45,7 @@ struct Setting {
   // Identity of the simulation (sweep and label excluded), for caches.
   std::string key() const;
   // The converged reference for the same input: 16x the substep rate (capped at the library's
-  // 20 000 Hz) and 4x the iterations (XPBD only: the mass-spring solver has none).
+  // 20 000 Hz) and 4x the iterations (XPBD only: the mass-spring solver has none), on the CPU.
   Setting reference() const;
 };
 
@@ -62,13 +62,14 @@ struct FrameErrors {
 };
 
 struct RunResult {
-  uint32_t particles = 0;      // actual vertex count of the garment built
+  uint32_t particles = 0;  // actual vertex count of the garment built
   uint32_t attached = 0;
-  std::vector<FrameTimes> times;          // steady frames only (no blend-in or teleport frame)
+  std::string device;                              // the OpenCL device, when that backend ran
+  std::vector<FrameTimes> times;                   // steady frames only (no blend-in or teleport frame)
   std::vector<std::vector<drape_vec3>> positions;  // per frame, when kept
   std::vector<drape_vec3> rest;
   std::vector<uint32_t> indices;
-  std::vector<uint8_t> pinned;            // 1 for attached vertices
+  std::vector<uint8_t> pinned;  // 1 for attached vertices
   // Error figures (measuring runs only).
   double stretch_p99 = 0, stretch_max = 0;
   double penetration_p99_mm = 0, penetration_max_mm = 0, deeper_than_2mm = 0;

@@ -27,7 +27,7 @@ void markDefaults(Sweep& sw) {
 }  // namespace
 
 std::vector<std::string> sweepNames() {
-  return {"solver", "substeps", "iterations", "ring_points", "contact_response", "continuous_collision",
+  return {"solver",     "substeps", "iterations", "ring_points", "contact_response", "continuous_collision",
           "resolution", "backend"};
 }
 
@@ -44,7 +44,8 @@ std::vector<Sweep> makeSweeps(bool quick, bool with_opencl) {
   }
   {
     Sweep sw{"substeps", "Substeps per simulated second (1 iteration each)", {}};
-    const std::vector<float> rates = quick ? std::vector<float>{150, 300} : std::vector<float>{60, 120, 150, 300, 600, 1200};
+    const std::vector<float> rates =
+        quick ? std::vector<float>{150, 300} : std::vector<float>{60, 120, 150, 300, 600, 1200};
     for (float r : rates) {
       Setting s = base("substeps", hz(r));
       s.substep_hz = r;
@@ -68,7 +69,8 @@ std::vector<Sweep> makeSweeps(bool quick, bool with_opencl) {
   }
   {
     Sweep sw{"ring_points", "Points per feature ring K (proxy fit)", {}};
-    const std::vector<uint32_t> ks = quick ? std::vector<uint32_t>{12, 20} : std::vector<uint32_t>{8, 12, 16, 20, 32, 48};
+    const std::vector<uint32_t> ks =
+        quick ? std::vector<uint32_t>{12, 20} : std::vector<uint32_t>{8, 12, 16, 20, 32, 48};
     for (uint32_t k : ks) {
       Setting s = base("ring_points", "K " + std::to_string(k));
       s.ring_points = k;

@@ -16,7 +16,7 @@ struct Sweep {
 };
 
 // quick: the few points CI runs (docs/benchmarks.md lists both sets). with_opencl: add the
-// OpenCL backend to the backend sweep.
+// OpenCL backend to the backend sweep (a run without a usable device notes it and goes on).
 std::vector<Sweep> makeSweeps(bool quick, bool with_opencl);
 
 // Names of all sweeps, for --sweeps and --help.

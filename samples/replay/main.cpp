@@ -486,6 +486,7 @@ int run(int argc, char** argv) {
   if (drape_result r = drape_context_get_frame_stats(ctx.get(), &final_stats))
     return fail(kExitFailure, "drape_context_get_frame_stats failed: " + libraryReason(r));
   st.teleports = final_stats.teleports;
+  st.pose_jumps = final_stats.pose_jumps;
   st.full_pipeline = opt.full_pipeline;
   drape_skip_stats final_skip{};
   final_skip.struct_size = sizeof final_skip;

@@ -103,6 +103,7 @@ std::string statsJson(const ReplayStats& s) {
   w.key("frames").value(s.frames);
   w.key("rejected_frames").value(s.rejected_frames);
   w.key("teleports").value(s.teleports);
+  w.key("pose_jumps").value(s.pose_jumps);
   w.key("nonfinite").value(static_cast<int64_t>(s.nonfinite));
   w.key("backend").value(s.backend);
   if (s.device.empty()) w.key("device").null();

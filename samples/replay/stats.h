@@ -36,6 +36,7 @@ struct ReplayStats {
   uint32_t frames = 0;            // frames replayed (read from the recording and pushed)
   uint32_t rejected_frames = 0;   // pushes the library rejected
   uint32_t teleports = 0;         // drape_frame_stats.teleports after the last frame
+  uint32_t pose_jumps = 0;        // drape_frame_stats.pose_jumps after the last frame
   uint64_t nonfinite = 0;         // NaN/Inf numbers in the library's outputs
   uint32_t vertices = 0;
   uint32_t triangles = 0;

@@ -554,6 +554,39 @@ struct Machine {
     fs.struct_size = (which & 16) ? in.u8() : sizeof fs;
     if (DRAPE_FUZZ_CALL(drape_context_get_frame_stats(h, &fs)) == DRAPE_OK && fs.updates > 0)
       DRAPE_FUZZ_CHECK(std::isfinite(fs.body_volume_l) && fs.body_volume_l > 0.0f, "body volume finite and positive");
+    pipeline(h, which);
+  }
+
+  // The adaptive pipeline (docs/adaptive.md): options from the input (flags 0-2, values nasty),
+  // a refused set changes nothing, the skip counters stay consistent, a wake is always accepted.
+  void pipeline(drape_context* h, uint8_t which) {
+    drape_pipeline_options before, o;
+    drape_pipeline_options_init(&before);
+    const bool live = DRAPE_FUZZ_CALL(drape_context_get_pipeline_options(h, &before)) == DRAPE_OK;
+    if (which & 0x80) {
+      drape_pipeline_options_init(&o);
+      o.cull_proxies = in.u8() % 3;
+      o.stages_on_demand = in.u8() % 3;
+      o.sleep = in.u8() % 3;
+      if (in.u8() & 1) o.sleep_delay_s = in.nasty();
+      if (in.u8() & 1) o.sleep_distance_m = in.nasty();
+      if (in.u8() & 1) o.sleep_speed_m_s = in.nasty();
+      if (in.u8() & 1) o.reach_margin_m = in.nasty();
+      if (DRAPE_FUZZ_CALL(drape_context_set_pipeline_options(h, &o)) != DRAPE_OK && live) {
+        drape_pipeline_options after;
+        drape_pipeline_options_init(&after);
+        DRAPE_FUZZ_CHECK(DRAPE_FUZZ_CALL(drape_context_get_pipeline_options(h, &after)) == DRAPE_OK, "get options");
+        DRAPE_FUZZ_CHECK(std::memcmp(&before, &after, sizeof before) == 0, "a refused set_pipeline_options changes nothing");
+      }
+    }
+    if (which & 0x40) DRAPE_FUZZ_CHECK((DRAPE_FUZZ_CALL(drape_context_wake(h)) == DRAPE_OK) == live, "wake a live context");
+    drape_skip_stats k;
+    std::memset(&k, 0, sizeof k);
+    k.struct_size = sizeof k;
+    if (DRAPE_FUZZ_CALL(drape_context_get_skip_stats(h, &k)) == DRAPE_OK)
+      DRAPE_FUZZ_CHECK(k.proxies_built <= k.proxies_available && k.garments_asleep <= k.garments &&
+                           k.frames_slept <= k.steps && k.garment_steps_slept >= k.frames_slept,
+                       "skip counters consistent");
   }
 
   void run() {

@@ -105,6 +105,35 @@ INSTANTIATE_TEST_SUITE_P(
                              {Chain::Torso, Chain::LegL, Chain::LegR},
                              {}}));
 
+// The built set is the union over the garments, recomputed as garments come and go.
+TEST(ProxyCulling, UnionFollowsGarmentsAddedAndRemoved) {
+  Context ctx(test::defaultDesc());
+  std::string err;
+  GarmentSim* skirt = test::addTemplate(ctx, GarmentKind::Skirt, 400, ClothSolverKind::Xpbd, GarmentSimParams{}, err);
+  ASSERT_NE(skirt, nullptr) << err;
+  const SkeletonPose pose = restPose(ctx.shape());
+  double t = 0.0;
+  auto frame = [&] {
+    stepPose(ctx, pose, t, 1.0f / 30.0f);
+    t += 1.0 / 30.0;
+  };
+  frame();
+  const uint32_t skirtOnly = ctx.skipCounters().proxies_built;
+  EXPECT_FALSE(reachedChains(ctx, *skirt).count(Chain::ArmL));
+  GarmentSim* shirt = test::addTemplate(ctx, GarmentKind::TShirt, 400, ClothSolverKind::Xpbd, GarmentSimParams{}, err);
+  ASSERT_NE(shirt, nullptr) << err;
+  frame();
+  const uint32_t both = ctx.skipCounters().proxies_built;
+  EXPECT_GT(both, skirtOnly);
+  EXPECT_TRUE(reachedChains(ctx, *shirt).count(Chain::ArmL));
+  std::set<int> u(skirt->reachable().begin(), skirt->reachable().end());
+  u.insert(shirt->reachable().begin(), shirt->reachable().end());
+  EXPECT_EQ(u.size(), both);  // exactly the union
+  ASSERT_TRUE(ctx.removeGarment(shirt));
+  frame();
+  EXPECT_EQ(ctx.skipCounters().proxies_built, skirtOnly);
+}
+
 TEST(ProxyCulling, NoGarmentBuildsNoEllipsoidUntilRead) {
   Context ctx(test::defaultDesc());
   stepPose(ctx, restPose(ctx.shape()), 0.0, 1.0f / 30.0f);

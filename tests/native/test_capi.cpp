@@ -1942,6 +1942,27 @@ TEST(Capi, DescSettingsTakeEffect) {
   const auto [far, farFlags] = teleportsFor(5.0f);
   EXPECT_EQ(far, 0u);
 
+  // A skeleton flipped upside down (every joint reflected through the pelvis) for frames 6-8: a
+  // pose jump on the flip and on the way back, no teleport (the pelvis stays).
+  {
+    ContextPtr ctx = makeContext(nullptr);
+    std::vector<uint8_t> flags;
+    for (int i = 0; i < 12; ++i) {
+      const double t = i / 30.0;
+      std::vector<drape_joint> j = poseJoints(DRAPE_LAYOUT_KINECT2, t);
+      const drape_vec3 c = j[0].position;
+      if (i >= 6 && i < 9)
+        for (drape_joint& k : j) k.position = drape_vec3{2 * c.x - k.position.x, 2 * c.y - k.position.y, 2 * c.z - k.position.z};
+      const drape_skeleton_frame f = makeFrame(DRAPE_LAYOUT_KINECT2, j, t);
+      EXPECT_EQ(drape_context_push_skeleton(ctx.get(), &f), DRAPE_OK);
+      EXPECT_EQ(drape_context_update(ctx.get()), DRAPE_OK);
+      flags.push_back(stats(ctx.get()).pose_jumped);
+    }
+    EXPECT_EQ(stats(ctx.get()).pose_jumps, 2u);
+    EXPECT_EQ(stats(ctx.get()).teleports, 0u);
+    for (int i = 0; i < 12; ++i) EXPECT_EQ(flags[static_cast<size_t>(i)], i == 6 || i == 9 ? 1 : 0) << "update " << i;
+  }
+
   // A desc from a newer header (larger struct_size) is accepted: only smaller sizes are rejected.
   struct Bigger {
     drape_context_desc desc;

@@ -351,3 +351,50 @@ TEST(OpenClKernels, FrameMatchesXpbdStep) {
 #endif
 }  // namespace
 }  // namespace drape
+
+namespace drape {
+namespace {
+#if DRAPE_HAVE_OPENCL
+// Large garments run one launch per phase over global memory instead of the one-work-group
+// frame: the same arithmetic per particle in the same order, so the same bits.
+TEST(OpenClKernels, PhaseLaunchesMatchTheWorkGroupFrameBitForBit) {
+  DRAPE_REQUIRE_OPENCL(rt);
+  std::vector<float> positions;
+  std::vector<uint32_t> indices;
+  makeClothGrid(30, 30, 1.0f, 1.0f, Vec3(-0.5f, 0.0f, -0.5f), Vec3::UnitX(), Vec3::UnitZ(), positions, indices);
+  TopologyParams tp;
+  tp.pinned = {0, 29};
+  GarmentTopology t;
+  std::string err;
+  ASSERT_TRUE(buildGarmentTopology(positions.data(), positions.size() / 3, indices.data(), indices.size(), tp, t, err));
+  XpbdParams p;
+  p.collision_stride = 2;
+  p.iterations = 2;
+  std::unique_ptr<ClXpbdSolver> solvers[2] = {ClXpbdSolver::create(rt, t, {}, {}, err),
+                                              ClXpbdSolver::create(rt, t, {}, {}, err)};
+  ASSERT_TRUE(solvers[0] && solvers[1]) << err;
+  solvers[0]->setPath(ClXpbdSolver::Path::WorkGroup);
+  solvers[1]->setPath(ClXpbdSolver::Path::Phases);
+  EXPECT_FALSE(solvers[0]->usesPhases());
+  EXPECT_TRUE(solvers[1]->usesPhases());
+  for (auto& s : solvers) ASSERT_TRUE(s->setParams(p, err)) << err;
+  for (int f = 0; f < 12; ++f) {
+    const float a = 0.05f * static_cast<float>(f), b = 0.05f * static_cast<float>(f + 1);
+    const Ellipsoid e0 = makeEllipsoid(Vec3(0.1f * a, -0.35f + a, 0.0f), Vec3(0.3f, 0.2f, 0.25f), a, Vec3(0, 1, 0));
+    const Ellipsoid e1 = makeEllipsoid(Vec3(0.1f * b, -0.35f + b, 0.0f), Vec3(0.3f, 0.2f, 0.25f), b, Vec3(0, 1, 0));
+    for (auto& s : solvers) {
+      ASSERT_TRUE(s->setColliderMotion(&e0, &e1, 1, 0.004f, {}, err));
+      const Vec3 pins[2] = {Vec3(-0.5f, 0.01f * f, -0.5f), Vec3(0.5f, 0.0f, -0.5f)};
+      ASSERT_TRUE(s->setPinTargets(pins, 2, err));
+      ASSERT_TRUE(s->step(1.0f / 30.0f, 10)) << s->lastError();
+    }
+    for (size_t i = 0; i < t.particleCount(); ++i)
+      ASSERT_EQ(solvers[0]->positions()[i], solvers[1]->positions()[i]) << "frame " << f << " particle " << i;
+    EXPECT_EQ(solvers[0]->lastCollisionStats().contacts, solvers[1]->lastCollisionStats().contacts);
+    EXPECT_EQ(solvers[0]->lastCollisionStats().tests, solvers[1]->lastCollisionStats().tests);
+  }
+  EXPECT_GT(solvers[0]->lastCollisionStats().tests, 0u);
+}
+#endif
+}  // namespace
+}  // namespace drape

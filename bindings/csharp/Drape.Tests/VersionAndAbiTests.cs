@@ -162,9 +162,9 @@ namespace Drape.Tests
         [Fact]
         public void FrameStats_Is72() => AssertLayout<FrameStats>(72,
             ("StructSize", 0), ("FramesPushed", 4), ("FramesAccepted", 8), ("FramesRejected", 12), ("FramesDropped", 16),
-            ("Updates", 20), ("Teleports", 24), ("Teleported", 28), ("Calibrated", 29), ("Reserved0", 30),
+            ("Updates", 20), ("Teleports", 24), ("Teleported", 28), ("Calibrated", 29), ("PoseJumped", 30),
             ("Reserved1", 31), ("LastTimestampS", 32), ("SkeletonMs", 40), ("BodyMs", 48), ("ProxiesMs", 56),
-            ("BodyVolumeL", 64), ("Reserved2", 68));
+            ("BodyVolumeL", 64), ("PoseJumps", 68));
 
         [Fact]
         public void Ellipsoid_Is68() => AssertLayout<Ellipsoid>(68,

@@ -360,8 +360,9 @@ namespace Drape
         public byte Teleported;
         /// <summary>calibrated (uint8_t): 1 once bone lengths are frozen.</summary>
         public byte Calibrated;
-        /// <summary>reserved0.</summary>
-        public byte Reserved0;
+        /// <summary>pose_jumped (uint8_t): 1 if the last update's frame was a pose jump (the torso
+        /// turned farther than a person can in the frame time; filters restarted, garments re-placed).</summary>
+        public byte PoseJumped;
         /// <summary>reserved1.</summary>
         public byte Reserved1;
         /// <summary>last_timestamp_s: of the last accepted frame.</summary>
@@ -374,8 +375,8 @@ namespace Drape
         public double ProxiesMs;
         /// <summary>body_volume_l: enclosed volume of the body mesh after the last update.</summary>
         public float BodyVolumeL;
-        /// <summary>reserved2.</summary>
-        public float Reserved2;
+        /// <summary>pose_jumps: pose jumps detected so far (docs/skeleton.md, "Pose jumps").</summary>
+        public uint PoseJumps;
 
         /// <summary><see cref="Teleported"/> as a bool.</summary>
         public bool IsTeleported => Teleported != 0;

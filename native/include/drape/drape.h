@@ -333,13 +333,16 @@ typedef struct drape_frame_stats {
   uint32_t teleports;         /* teleports detected so far */
   uint8_t teleported;         /* 1 if the last update's frame was a teleport */
   uint8_t calibrated;         /* 1 once bone lengths are frozen */
-  uint8_t reserved0, reserved1;
+  uint8_t pose_jumped;        /* 1 if the last update's frame was a pose jump: the torso turned
+                                 farther than a person can in the frame time (a skeleton flipped
+                                 upside down); filters restarted, garments re-placed */
+  uint8_t reserved1;
   double last_timestamp_s;    /* of the last accepted frame */
   double skeleton_ms;         /* wall time of the last update's skeleton stage */
   double body_ms;             /* wall time of the last update's ring + mesh stage */
   double proxies_ms;          /* wall time of the last update's tracking-ellipsoid stage */
   float body_volume_l;        /* enclosed volume of the body mesh after the last update */
-  float reserved2;
+  uint32_t pose_jumps;        /* pose jumps detected so far (docs/skeleton.md, "Pose jumps") */
 } drape_frame_stats;
 
 DRAPE_API drape_result DRAPE_CALL drape_context_get_frame_stats(drape_context* context,
@@ -596,8 +599,9 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_measure(drape_garment* garment,
  *    and drape_garment_measure build the rest for the current frame first.
  *  - stages_on_demand: the body mesh's positions and normals are computed when read
  *    (drape_context_read_body_mesh), measured (fidelity, garment accuracy) or needed by
- *    drape_context_get_frame_stats (body volume), not on every update. Off: every update computes
- *    them (a host that reads the mesh every frame gains nothing from laziness).
+ *    drape_context_get_frame_stats (body volume), not on every update (drape_frame_stats.body_ms
+ *    then times the rings only). Off: every update computes them (a host that reads the mesh
+ *    every frame gains nothing from laziness).
  *  - sleep: a garment whose particles have all moved slower than sleep_speed_m_s for
  *    sleep_delay_s while every joint stayed within sleep_distance_m of where it was skips its steps.
  *    It wakes, before anything is built for that frame, when a joint leaves that distance, on a

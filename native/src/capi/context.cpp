@@ -201,6 +201,7 @@ drape_result Context::update(std::string& err) {
     hasQueued_ = false;
     skeletonMs_ = msSince(t0);
     teleported_ = tracker_.teleportedLastPush();
+    poseJumped_ = tracker_.poseJumpedLastPush();
     teleportPending_ = teleportPending_ || teleported_;
     ++updates_;
   } else if (!shapeDirty_) {
@@ -252,13 +253,14 @@ void Context::fillStats(drape_frame_stats& out) {
   out.teleports = tracker_.teleportCount();
   out.teleported = teleported_ ? 1 : 0;
   out.calibrated = tracker_.calibrated() ? 1 : 0;
-  out.reserved0 = out.reserved1 = 0;
+  out.pose_jumped = poseJumped_ ? 1 : 0;
+  out.reserved1 = 0;
   out.last_timestamp_s = lastAcceptedTime_;
   out.skeleton_ms = skeletonMs_;
   out.body_ms = bodyMs_;
   out.proxies_ms = proxiesMs_;
   out.body_volume_l = updated_ ? volumeL_ : 0.0f;
-  out.reserved2 = 0.0f;
+  out.pose_jumps = tracker_.poseJumpCount();
 }
 
 }  // namespace drape

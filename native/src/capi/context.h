@@ -117,6 +117,7 @@ class Context {
 
   uint32_t pushed_ = 0, accepted_ = 0, rejected_ = 0, dropped_ = 0, updates_ = 0;
   bool teleported_ = false;
+  bool poseJumped_ = false;  // the last update's frame was a pose jump (tracker.h)
   double skeletonMs_ = 0.0, bodyMs_ = 0.0, proxiesMs_ = 0.0;
   float volumeL_ = 0.0f;
   bool volumeDirty_ = true;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <utility>
 
 namespace drape {
 namespace {
@@ -92,8 +93,8 @@ std::unique_ptr<ClXpbdSolver> ClXpbdSolver::create(std::shared_ptr<ClRuntime> ru
 }
 
 ClXpbdSolver::~ClXpbdSolver() {
-  if (frame_) clReleaseKernel(frame_);
-  if (transform_) clReleaseKernel(transform_);
+  for (cl_kernel k : {frame_, transform_, predict_, pins_, pin_start_, project_, collide_velocity_, clear_stats_})
+    if (k) clReleaseKernel(k);
   for (cl_mem* m : {&garment_, &x_buf_, &prev_buf_, &v_buf_, &span_start_buf_, &pin_start_buf_, &pin_index_buf_,
                     &pin_target_buf_, &constraint_buf_, &group_buf_, &mask_buf_, &shape_buf_, &bounds_buf_,
                     &stats_buf_})
@@ -129,8 +130,14 @@ bool ClXpbdSolver::allocate(std::string& err) {
     err = std::string("OpenCL buffer allocation failed (") + clErrorName(rc) + ")";
     return false;
   }
-  frame_ = clCreateKernel(runtime_->program(), "drape_xpbd_frame", &rc);
-  if (rc == CL_SUCCESS) transform_ = clCreateKernel(runtime_->program(), "drape_transform", &rc);
+  const std::pair<cl_kernel*, const char*> kernels[] = {
+      {&frame_, "drape_xpbd_frame"}, {&transform_, "drape_transform"}, {&predict_, "drape_phase_predict"},
+      {&pins_, "drape_phase_pins"}, {&pin_start_, "drape_phase_pin_start"}, {&project_, "drape_project_group"},
+      {&collide_velocity_, "drape_phase_collide_velocity"}, {&clear_stats_, "drape_phase_clear_stats"}};
+  for (const auto& k : kernels) {
+    if (rc == CL_SUCCESS) *k.first = clCreateKernel(runtime_->program(), k.second, &rc);
+    if (rc != CL_SUCCESS) *k.first = nullptr;
+  }
   if (rc != CL_SUCCESS) {
     err = std::string("clCreateKernel failed (") + clErrorName(rc) + ")";
     return false;
@@ -139,6 +146,21 @@ bool ClXpbdSolver::allocate(std::string& err) {
                          pin_target_buf_, constraint_buf_, group_buf_, mask_buf_, shape_buf_, bounds_buf_,
                          stats_buf_};
   for (cl_uint i = 0; i < 14 && rc == CL_SUCCESS; ++i) rc = clSetKernelArg(frame_, i, sizeof(cl_mem), &args[i]);
+  // The per-phase kernels' buffer arguments (the rest are set per launch).
+  auto set = [&](cl_kernel k, cl_uint i, const cl_mem& m) {
+    if (rc == CL_SUCCESS) rc = clSetKernelArg(k, i, sizeof(cl_mem), &m);
+  };
+  set(predict_, 0, garment_), set(predict_, 1, x_buf_), set(predict_, 2, prev_buf_), set(predict_, 3, v_buf_),
+      set(predict_, 4, span_start_buf_);
+  set(pins_, 0, garment_), set(pins_, 1, x_buf_), set(pins_, 2, pin_start_buf_), set(pins_, 3, pin_index_buf_),
+      set(pins_, 4, pin_target_buf_);
+  set(pin_start_, 0, garment_), set(pin_start_, 1, x_buf_), set(pin_start_, 2, pin_start_buf_),
+      set(pin_start_, 3, pin_index_buf_);
+  set(project_, 0, x_buf_), set(project_, 1, constraint_buf_);
+  set(collide_velocity_, 0, garment_), set(collide_velocity_, 1, x_buf_), set(collide_velocity_, 2, prev_buf_),
+      set(collide_velocity_, 3, v_buf_), set(collide_velocity_, 4, span_start_buf_), set(collide_velocity_, 5, mask_buf_),
+      set(collide_velocity_, 6, shape_buf_), set(collide_velocity_, 7, bounds_buf_), set(collide_velocity_, 8, stats_buf_);
+  set(clear_stats_, 0, stats_buf_);
   // Static data once: pin indices, group table, masks (0xFF: every group when none given).
   std::vector<uint8_t> masks(masks_);
   masks.resize(n, 0xFF);
@@ -183,6 +205,58 @@ bool ClXpbdSolver::uploadState() {
 bool ClXpbdSolver::pushPositions() {
   if (particleCount() == 0) return true;
   return upload(x_buf_, x_.data(), particleCount() * 16, nullptr);
+}
+
+bool ClXpbdSolver::enqueuePhases(const DrapeClGarment& g, std::vector<cl_event>& runs) {
+  cl_command_queue q = runtime_->queue();
+  cl_int rc = CL_SUCCESS;
+  const size_t n = particleCount();
+  auto launch = [&](cl_kernel k, size_t items, bool keep_event) {
+    if (rc != CL_SUCCESS || items == 0) return;
+    const size_t global = (items + 63) / 64 * 64;
+    cl_event e = nullptr;
+    rc = clEnqueueNDRangeKernel(q, k, 1, nullptr, &global, nullptr, 0, nullptr, keep_event ? &e : nullptr);
+    if (rc == CL_SUCCESS && keep_event) runs.push_back(e);
+  };
+  auto arg = [&](cl_kernel k, cl_uint i, auto v) {
+    if (rc == CL_SUCCESS) rc = clSetKernelArg(k, i, sizeof(v), &v);
+  };
+  // The first launch keeps its event (start of the kernel time), as does the last (below).
+  launch(clear_stats_, 1, true);
+  launch(pin_start_, pin_index_.size(), false);
+  const int stride = g.stride;
+  int span0 = 0, span = 0;
+  for (int s = 0; s < g.substeps; ++s) {
+    const bool collide = (s + 1 - span0) >= stride || s + 1 == g.substeps;
+    arg(predict_, 5, static_cast<cl_int>(stride > 1 && s == span0));
+    launch(predict_, n, false);
+    arg(pins_, 5, static_cast<cl_int>(s));
+    launch(pins_, pin_index_.size(), false);
+    for (int it = 0; it < g.iterations; ++it) {
+      for (uint32_t c = 0; c < distance_groups_ + tether_groups_; ++c) {
+        const bool tether = c >= distance_groups_;
+        const uint32_t at = tether ? distance_groups_ + 1 + (c - distance_groups_) : c;
+        const cl_uint begin = group_offsets_[at], end = group_offsets_[at + 1];
+        arg(project_, 2, begin);
+        arg(project_, 3, end);
+        arg(project_, 4, static_cast<cl_uint>(tether ? 1 : 0));
+        arg(project_, 5, g.tether_scale);
+        launch(project_, end - begin, false);
+      }
+    }
+    arg(collide_velocity_, 9, static_cast<cl_int>(collide ? 1 : 0));
+    arg(collide_velocity_, 10, static_cast<cl_int>(span));
+    launch(collide_velocity_, n, s + 1 == g.substeps);
+    if (collide) {
+      span0 = s + 1;
+      ++span;
+    }
+  }
+  if (rc != CL_SUCCESS) {
+    device_error_ = std::string("OpenCL phase launch failed (") + clErrorName(rc) + ")";
+    return false;
+  }
+  return true;
 }
 
 bool ClXpbdSolver::setParams(const XpbdParams& p, std::string& error) {
@@ -391,12 +465,14 @@ bool ClXpbdSolver::step(float dt, int substeps) {
     shape_capacity_ = shapes_.size() * 2;
     shape_buf_ = clCreateBuffer(runtime_->context(), CL_MEM_READ_ONLY, shape_capacity_ * sizeof(DrapeClShape), nullptr, &rc);
     if (rc == CL_SUCCESS) rc = clSetKernelArg(frame_, 11, sizeof(cl_mem), &shape_buf_);
+    if (rc == CL_SUCCESS) rc = clSetKernelArg(collide_velocity_, 6, sizeof(cl_mem), &shape_buf_);
   }
   if (rc == CL_SUCCESS && bounds_.size() > bounds_capacity_) {
     release(bounds_buf_);
     bounds_capacity_ = bounds_.size() * 2;
     bounds_buf_ = clCreateBuffer(runtime_->context(), CL_MEM_READ_ONLY, bounds_capacity_ * 16, nullptr, &rc);
     if (rc == CL_SUCCESS) rc = clSetKernelArg(frame_, 12, sizeof(cl_mem), &bounds_buf_);
+    if (rc == CL_SUCCESS) rc = clSetKernelArg(collide_velocity_, 7, sizeof(cl_mem), &bounds_buf_);
   }
   if (rc != CL_SUCCESS) {
     device_error_ = std::string("OpenCL shape buffer failed (") + clErrorName(rc) + ")";
@@ -412,7 +488,9 @@ bool ClXpbdSolver::step(float dt, int substeps) {
     ok = upload(constraint_buf_, constraints_.data(), constraints_.size() * sizeof(DrapeClConstraint), &writes);
     constraints_dirty_ = !ok;
   }
-  if (ok) {
+  if (ok && usesPhases()) {
+    ok = enqueuePhases(g, runs);
+  } else if (ok) {
     const size_t wg = runtime_->workGroup();
     cl_event e = nullptr;
     rc = clEnqueueNDRangeKernel(runtime_->queue(), frame_, 1, nullptr, &wg, &wg, 0, nullptr, &e);
@@ -443,7 +521,16 @@ bool ClXpbdSolver::step(float dt, int substeps) {
   const double wall = std::chrono::duration<double, std::nano>(Clock::now() - wall0).count();
   const bool prof = runtime_->profiling();
   timings_.upload_ns = sumAndRelease(writes, prof);
-  timings_.kernel_ns = sumAndRelease(runs, prof);
+  if (runs.size() > 1) {
+    // Phases: from the first launch's start to the last one's end (launch gaps included).
+    cl_ulong first = 0, last = 0;
+    if (prof && clGetEventProfilingInfo(runs.front(), CL_PROFILING_COMMAND_START, sizeof(first), &first, nullptr) == CL_SUCCESS &&
+        clGetEventProfilingInfo(runs.back(), CL_PROFILING_COMMAND_END, sizeof(last), &last, nullptr) == CL_SUCCESS)
+      timings_.kernel_ns = static_cast<double>(last - first);
+    sumAndRelease(runs, false);
+  } else {
+    timings_.kernel_ns = sumAndRelease(runs, prof);
+  }
   timings_.readback_ns = sumAndRelease(reads, prof);
   if (!prof) timings_.kernel_ns = wall;
   if (!ok) {

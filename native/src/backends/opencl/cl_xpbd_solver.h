@@ -63,7 +63,15 @@ class ClXpbdSolver {
   const CollisionStats& lastCollisionStats() const { return collision_stats_; }
   const ClStepTimings& lastTimings() const { return timings_; }
   const std::string& lastError() const { return device_error_; }
-  bool usesLocalMemory() const { return particleCount() <= runtime_->localParticles(); }
+  bool usesLocalMemory() const { return !usesPhases() && particleCount() <= runtime_->localParticles(); }
+  // How a frame runs. Auto: one work-group launch (drape_xpbd_frame) while the particles fit in
+  // __local memory, else one launch per phase over global memory (drape_phase_*: every compute
+  // unit takes part). The two give bit-identical results (tested).
+  enum class Path { Auto, WorkGroup, Phases };
+  void setPath(Path p) { path_ = p; }
+  bool usesPhases() const {
+    return path_ == Path::Phases || (path_ == Path::Auto && particleCount() > runtime_->localParticles());
+  }
   const ClRuntime& runtime() const { return *runtime_; }
 
  private:
@@ -95,7 +103,12 @@ class ClXpbdSolver {
   std::vector<DrapeClShape> shapes_;
   std::vector<DclF4> bounds_;
 
+  bool enqueuePhases(const DrapeClGarment& g, std::vector<cl_event>& runs);
+  Path path_ = Path::Auto;
   cl_kernel frame_ = nullptr, transform_ = nullptr;
+  // The per-phase kernels (large garments).
+  cl_kernel predict_ = nullptr, pins_ = nullptr, pin_start_ = nullptr, project_ = nullptr,
+            collide_velocity_ = nullptr, clear_stats_ = nullptr;
   cl_mem garment_ = nullptr, x_buf_ = nullptr, prev_buf_ = nullptr, v_buf_ = nullptr,
          span_start_buf_ = nullptr, pin_start_buf_ = nullptr, pin_index_buf_ = nullptr,
          pin_target_buf_ = nullptr, constraint_buf_ = nullptr, group_buf_ = nullptr,
