@@ -129,7 +129,8 @@ void runFrames(S& s, Scene& sc, size_t& frame, int count, bool collide, Motion&&
   }
 }
 
-// Args: backend (0 CPU, 1 OpenCL), target particles, collide (0/1).
+// Args: backend (0 CPU, 1 OpenCL), target particles, collide (0/1), path (OpenCL: 0 = automatic
+// choice, ClXpbdSolver::Path::Auto; 1 = the one-work-group frame forced).
 void BM_BackendGarmentFrame(benchmark::State& state) {
   const bool opencl = state.range(0) == 1;
   const bool collide = state.range(2) == 1;
@@ -166,6 +167,7 @@ void BM_BackendGarmentFrame(benchmark::State& state) {
     if (!rt) return state.SkipWithError(("no OpenCL device: " + why).c_str());
     auto s = ClXpbdSolver::create(rt, sc.topology, {}, {}, error);
     if (!s) return state.SkipWithError(error.c_str());
+    if (state.range(3) == 1) s->setPath(ClXpbdSolver::Path::WorkGroup);
     s->setParams(benchParams(), error);
     s->transform(sc.rotation, sc.pivot, sc.shift, 0.0f);
     auto motion = [&](const std::vector<Ellipsoid>& e0, const std::vector<Ellipsoid>& e1) {
@@ -186,6 +188,7 @@ void BM_BackendGarmentFrame(benchmark::State& state) {
     state.counters["readback_ms"] = c / n;
     state.counters["host_ms"] = d / n;
     state.counters["local_mem"] = s->usesLocalMemory() ? 1.0 : 0.0;
+    state.counters["phases"] = s->usesPhases() ? 1.0 : 0.0;
     state.SetLabel(rt->deviceName());
 #else
     return state.SkipWithError("built without OpenCL");
@@ -196,10 +199,12 @@ void BM_BackendGarmentFrame(benchmark::State& state) {
 
 void backendArgs(benchmark::internal::Benchmark* b) {
   for (int particles : {2000, 8000, 32000, 128000})
-    for (int collide : {1, 0})
-      for (int backend : {0, 1}) b->Args({backend, particles, collide});
+    for (int collide : {1, 0}) {
+      for (int backend : {0, 1}) b->Args({backend, particles, collide, 0});
+      if (particles >= 8000 && particles <= 32000) b->Args({1, particles, collide, 1});  // work-group forced
+    }
 }
-BENCHMARK(BM_BackendGarmentFrame)->Apply(backendArgs)->ArgNames({"opencl", "particles", "collide"})
+BENCHMARK(BM_BackendGarmentFrame)->Apply(backendArgs)->ArgNames({"opencl", "particles", "collide", "workgroup"})
     ->Unit(benchmark::kMillisecond)->MinTime(0.5);
 
 }  // namespace

@@ -197,8 +197,13 @@ TEST(SkeletonTrackerRecording, NoiseEstimateFindsJitterAndIgnoresJumps) {
     }
     ASSERT_GT(sigma_clean.size(), 20u);
     const double p95 = percentile(sigma_clean, 0.95), jit = percentile(sigma_jitter, 0.5);
-    std::printf("[ noise    ] %s: clean P95 %.1f mm, beta %.2f; 5 cm jitter median %.1f mm, beta %.2f; flipped max %.1f mm\n",
-                rel, 1000 * p95, clean.effectiveBeta(), 1000 * jit, jittered.effectiveBeta(), 1000 * flip_sigma);
+    std::printf("[ noise    ] %s: clean P95 %.1f mm, beta %.2f; 5 cm jitter median %.1f mm, beta %.2f, %u pose jumps; "
+                "flipped max %.1f mm\n",
+                rel, 1000 * p95, clean.effectiveBeta(), 1000 * jit, jittered.effectiveBeta(), jittered.poseJumpCount(),
+                1000 * flip_sigma);
+    EXPECT_EQ(clean.poseJumpCount(), 0u);
+    EXPECT_EQ(jittered.poseJumpCount(), 0u) << "5 cm of jitter turns the torso by degrees, not a pose jump";
+    EXPECT_EQ(flipped.poseJumpCount(), 2u);
     EXPECT_LT(p95, 0.006) << "the real sensor noise is millimetres";
     EXPECT_GT(clean.effectiveBeta(), 0.8f * clean.params().beta);
     EXPECT_NEAR(jit, 0.05, 0.015) << "the added jitter is found";

@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <functional>
 #include <random>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -82,9 +83,18 @@ inline bool loadTake(const std::string& path, Take& take, std::string& err) {
     ASSERT_TRUE(::stress::loadTake(var##_path, var, load_err)) << load_err;      \
   }
 
+// The scenarios dress a 1 000-particle T-shirt; DRAPE_STRESS_PARTICLES=N (>= 200) dresses another
+// resolution, to see how much a figure depends on it (docs/robustness.md, "Sensitivity").
+inline uint32_t defaultParticles() {
+  const char* w = std::getenv("DRAPE_STRESS_PARTICLES");
+  if (w == nullptr) return 1000u;
+  const int n = std::atoi(w);
+  return n >= 200 ? static_cast<uint32_t>(n) : 1000u;
+}
+
 struct Dressing {
   int32_t kind = DRAPE_GARMENT_TSHIRT;
-  uint32_t particles = 1000;
+  uint32_t particles = defaultParticles();
   bool set_shape = false;
   drape_body_shape shape{};
   bool set_desc = false;

@@ -233,7 +233,9 @@ typedef struct drape_skeleton_frame {
 DRAPE_API drape_result DRAPE_CALL drape_context_push_skeleton(drape_context* context,
                                                               const drape_skeleton_frame* frame);
 
-/* Runs the pipeline on the queued frame: skeleton filter -> feature rings -> body mesh.
+/* Runs the pipeline on the queued frame: skeleton filter -> feature rings -> body mesh (by
+ * default the mesh and the tracking ellipsoids only as far as something needs them: see
+ * "Adaptive pipeline").
  * DRAPE_ERROR_CALL_ORDER if no frame was ever accepted. Calling it again without a new frame is
  * allowed and cheap (nothing changes). Thread-safety: one thread per context. */
 DRAPE_API drape_result DRAPE_CALL drape_context_update(drape_context* context);

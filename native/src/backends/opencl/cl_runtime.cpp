@@ -131,7 +131,6 @@ bool ClRuntime::build(const ClChoice& choice, std::string& err) {
   }
   if (choice.host_context) {
     // The host's context and queue: the device is the queue's.
-    owns_ = false;
     context_ = static_cast<cl_context>(choice.host_context);
     queue_ = static_cast<cl_command_queue>(choice.host_queue);
     if ((rc = clGetCommandQueueInfo(queue_, CL_QUEUE_DEVICE, sizeof(device_), &device_, nullptr)) != CL_SUCCESS) {

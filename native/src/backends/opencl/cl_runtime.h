@@ -67,7 +67,6 @@ class ClRuntime {
   cl_command_queue queue_ = nullptr;
   cl_device_id device_ = nullptr;
   cl_program program_ = nullptr;
-  bool owns_ = true;
   bool profiling_ = false;
   std::string device_name_, platform_name_;
   size_t local_particles_ = 1, work_group_ = 64;

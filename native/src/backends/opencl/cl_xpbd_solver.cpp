@@ -3,32 +3,13 @@
 #include "backends/opencl/cl_shapes.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <utility>
 
 namespace drape {
 namespace {
 
-using Clock = std::chrono::steady_clock;
 
-double eventNs(cl_event e) {
-  cl_ulong a = 0, b = 0;
-  if (clGetEventProfilingInfo(e, CL_PROFILING_COMMAND_START, sizeof(a), &a, nullptr) != CL_SUCCESS ||
-      clGetEventProfilingInfo(e, CL_PROFILING_COMMAND_END, sizeof(b), &b, nullptr) != CL_SUCCESS)
-    return 0.0;
-  return static_cast<double>(b - a);
-}
-
-double sumAndRelease(std::vector<cl_event>& events, bool profiling) {
-  double ns = 0.0;
-  for (cl_event e : events) {
-    if (profiling) ns += eventNs(e);
-    clReleaseEvent(e);
-  }
-  events.clear();
-  return ns;
-}
 
 void release(cl_mem& m) {
   if (m) clReleaseMemObject(m);
@@ -207,57 +188,6 @@ bool ClXpbdSolver::pushPositions() {
   return upload(x_buf_, x_.data(), particleCount() * 16, nullptr);
 }
 
-bool ClXpbdSolver::enqueuePhases(const DrapeClGarment& g, std::vector<cl_event>& runs) {
-  cl_command_queue q = runtime_->queue();
-  cl_int rc = CL_SUCCESS;
-  const size_t n = particleCount();
-  auto launch = [&](cl_kernel k, size_t items, bool keep_event) {
-    if (rc != CL_SUCCESS || items == 0) return;
-    const size_t global = (items + 63) / 64 * 64;
-    cl_event e = nullptr;
-    rc = clEnqueueNDRangeKernel(q, k, 1, nullptr, &global, nullptr, 0, nullptr, keep_event ? &e : nullptr);
-    if (rc == CL_SUCCESS && keep_event) runs.push_back(e);
-  };
-  auto arg = [&](cl_kernel k, cl_uint i, auto v) {
-    if (rc == CL_SUCCESS) rc = clSetKernelArg(k, i, sizeof(v), &v);
-  };
-  // The first launch keeps its event (start of the kernel time), as does the last (below).
-  launch(clear_stats_, 1, true);
-  launch(pin_start_, pin_index_.size(), false);
-  const int stride = g.stride;
-  int span0 = 0, span = 0;
-  for (int s = 0; s < g.substeps; ++s) {
-    const bool collide = (s + 1 - span0) >= stride || s + 1 == g.substeps;
-    arg(predict_, 5, static_cast<cl_int>(stride > 1 && s == span0));
-    launch(predict_, n, false);
-    arg(pins_, 5, static_cast<cl_int>(s));
-    launch(pins_, pin_index_.size(), false);
-    for (int it = 0; it < g.iterations; ++it) {
-      for (uint32_t c = 0; c < distance_groups_ + tether_groups_; ++c) {
-        const bool tether = c >= distance_groups_;
-        const uint32_t at = tether ? distance_groups_ + 1 + (c - distance_groups_) : c;
-        const cl_uint begin = group_offsets_[at], end = group_offsets_[at + 1];
-        arg(project_, 2, begin);
-        arg(project_, 3, end);
-        arg(project_, 4, static_cast<cl_uint>(tether ? 1 : 0));
-        arg(project_, 5, g.tether_scale);
-        launch(project_, end - begin, false);
-      }
-    }
-    arg(collide_velocity_, 9, static_cast<cl_int>(collide ? 1 : 0));
-    arg(collide_velocity_, 10, static_cast<cl_int>(span));
-    launch(collide_velocity_, n, s + 1 == g.substeps);
-    if (collide) {
-      span0 = s + 1;
-      ++span;
-    }
-  }
-  if (rc != CL_SUCCESS) {
-    device_error_ = std::string("OpenCL phase launch failed (") + clErrorName(rc) + ")";
-    return false;
-  }
-  return true;
-}
 
 bool ClXpbdSolver::setParams(const XpbdParams& p, std::string& error) {
   XpbdSolver probe{GarmentTopology{}};  // the CPU solver's validation, message for message
@@ -398,153 +328,5 @@ const Eigen::Vector4f* ClXpbdSolver::velocities() const {
   return v_.data();
 }
 
-bool ClXpbdSolver::step(float dt, int substeps) {
-  if (!(dt > 0.0f) || !(dt <= 1.0f) || substeps < 1 || substeps > 1000) return false;
-  timings_ = ClStepTimings{};
-  collision_stats_ = CollisionStats{};
-  const size_t n = particleCount();
-  if (n == 0) return true;
-  const auto host0 = Clock::now();
-  const float h = dt / static_cast<float>(substeps);
-  const float inv_h2 = 1.0f / (h * h);
-  if (inv_h2 != inv_w_h2_) refreshInvW(inv_h2);
-  const int count = static_cast<int>(motion_start_.size());
-  const int stride = params_.collision_stride;
-  if (count > 0) {
-    packFrameShapes(motion_start_.data(), motion_end_.data(), count, motion_margin_, groups_, substeps, stride,
-                    shapes_, bounds_);
-  } else {
-    shapes_.clear();
-    bounds_.clear();
-  }
-  for (size_t k = 0; k < pin_target_.size(); ++k)
-    pin_target4_[k] = DclF4{pin_target_[k].x(), pin_target_[k].y(), pin_target_[k].z(), 0.0f};
-
-  const XpbdParams& p = params_;
-  DrapeClGarment g{};
-  g.hg = DclF4{h * p.gravity.x(), h * p.gravity.y(), h * p.gravity.z(), 0.0f};
-  g.wind = DclF4{p.wind.x(), p.wind.y(), p.wind.z(), 0.0f};
-  g.particle_offset = 0;
-  g.particle_count = static_cast<uint32_t>(n);
-  g.distance_group_offset = 0;
-  g.distance_groups = distance_groups_;
-  g.tether_group_offset = distance_groups_ + 1;
-  g.tether_groups = tether_groups_;
-  g.pin_offset = 0;
-  g.pin_count = static_cast<uint32_t>(pin_index_.size());
-  g.shape_offset = 0;
-  g.shape_count = static_cast<uint32_t>(count);
-  g.span_offset = 0;
-  const CollisionParams& cp = p.collision;
-  g.flags = (cp.continuous ? DRAPE_CL_CONTINUOUS : 0u) | (cp.response == ContactResponse::Exact ? DRAPE_CL_EXACT : 0u) |
-            (!masks_.empty() && groups_.size() == static_cast<size_t>(count) && count > 0 &&
-                     count <= EllipsoidCollider::kMaxGridEllipsoids
-                 ? DRAPE_CL_GROUPED
-                 : 0u) |
-            (n <= runtime_->localParticles() ? DRAPE_CL_LOCAL : 0u);
-  g.substeps = substeps;
-  g.stride = stride;
-  g.iterations = p.iterations;
-  g.h = h;
-  g.inv_n = 1.0f / static_cast<float>(substeps);
-  g.h_drag = h * p.drag;
-  g.max_speed = p.max_speed;
-  g.max_speed2 = p.max_speed > 0.0f ? p.max_speed * p.max_speed : 0.0f;
-  g.velocity_scale = std::exp(-p.damping * h) / h;
-  g.tether_scale = p.tether_scale;
-  // The collider clamps friction to [0, 1e6] (NaN -> 0).
-  g.static_friction = cp.static_friction > 0.0f ? std::min(cp.static_friction, 1e6f) : 0.0f;
-  g.kinetic_friction = cp.kinetic_friction > 0.0f ? std::min(cp.kinetic_friction, 1e6f) : 0.0f;
-  g.max_escape = cp.max_escape_m;
-  timings_.host_ns = std::chrono::duration<double, std::nano>(Clock::now() - host0).count();
-
-  // Grow the shape buffers (rare: more substeps or ellipsoids than before).
-  cl_int rc = CL_SUCCESS;
-  if (shapes_.size() > shape_capacity_) {
-    release(shape_buf_);
-    shape_capacity_ = shapes_.size() * 2;
-    shape_buf_ = clCreateBuffer(runtime_->context(), CL_MEM_READ_ONLY, shape_capacity_ * sizeof(DrapeClShape), nullptr, &rc);
-    if (rc == CL_SUCCESS) rc = clSetKernelArg(frame_, 11, sizeof(cl_mem), &shape_buf_);
-    if (rc == CL_SUCCESS) rc = clSetKernelArg(collide_velocity_, 6, sizeof(cl_mem), &shape_buf_);
-  }
-  if (rc == CL_SUCCESS && bounds_.size() > bounds_capacity_) {
-    release(bounds_buf_);
-    bounds_capacity_ = bounds_.size() * 2;
-    bounds_buf_ = clCreateBuffer(runtime_->context(), CL_MEM_READ_ONLY, bounds_capacity_ * 16, nullptr, &rc);
-    if (rc == CL_SUCCESS) rc = clSetKernelArg(frame_, 12, sizeof(cl_mem), &bounds_buf_);
-    if (rc == CL_SUCCESS) rc = clSetKernelArg(collide_velocity_, 7, sizeof(cl_mem), &bounds_buf_);
-  }
-  if (rc != CL_SUCCESS) {
-    device_error_ = std::string("OpenCL shape buffer failed (") + clErrorName(rc) + ")";
-    return false;
-  }
-  std::vector<cl_event> writes, runs, reads;
-  const auto wall0 = Clock::now();
-  bool ok = upload(garment_, &g, sizeof(g), &writes) &&
-            upload(pin_target_buf_, pin_target4_.data(), pin_target4_.size() * 16, &writes) &&
-            upload(shape_buf_, shapes_.data(), shapes_.size() * sizeof(DrapeClShape), &writes) &&
-            upload(bounds_buf_, bounds_.data(), bounds_.size() * 16, &writes);
-  if (ok && constraints_dirty_ && !constraints_.empty()) {
-    ok = upload(constraint_buf_, constraints_.data(), constraints_.size() * sizeof(DrapeClConstraint), &writes);
-    constraints_dirty_ = !ok;
-  }
-  if (ok && usesPhases()) {
-    ok = enqueuePhases(g, runs);
-  } else if (ok) {
-    const size_t wg = runtime_->workGroup();
-    cl_event e = nullptr;
-    rc = clEnqueueNDRangeKernel(runtime_->queue(), frame_, 1, nullptr, &wg, &wg, 0, nullptr, &e);
-    if (rc == CL_SUCCESS) {
-      runs.push_back(e);
-    } else {
-      device_error_ = std::string("clEnqueueNDRangeKernel failed (") + clErrorName(rc) + ")";
-      ok = false;
-    }
-  }
-  DrapeClStats stats{};
-  std::vector<Eigen::Vector4f> x_back;
-  if (ok) {
-    x_back.resize(n);
-    cl_event e1 = nullptr, e2 = nullptr;
-    rc = clEnqueueReadBuffer(runtime_->queue(), stats_buf_, CL_FALSE, 0, sizeof(stats), &stats, 0, nullptr, &e1);
-    if (rc == CL_SUCCESS) {
-      reads.push_back(e1);
-      rc = clEnqueueReadBuffer(runtime_->queue(), x_buf_, CL_TRUE, 0, n * 16, x_back.data(), 0, nullptr, &e2);
-      if (rc == CL_SUCCESS) reads.push_back(e2);
-    }
-    if (rc == CL_SUCCESS) rc = clFinish(runtime_->queue());
-    if (rc != CL_SUCCESS) {
-      device_error_ = std::string("OpenCL frame failed (") + clErrorName(rc) + ")";
-      ok = false;
-    }
-  }
-  const double wall = std::chrono::duration<double, std::nano>(Clock::now() - wall0).count();
-  const bool prof = runtime_->profiling();
-  timings_.upload_ns = sumAndRelease(writes, prof);
-  if (runs.size() > 1) {
-    // Phases: from the first launch's start to the last one's end (launch gaps included).
-    cl_ulong first = 0, last = 0;
-    if (prof && clGetEventProfilingInfo(runs.front(), CL_PROFILING_COMMAND_START, sizeof(first), &first, nullptr) == CL_SUCCESS &&
-        clGetEventProfilingInfo(runs.back(), CL_PROFILING_COMMAND_END, sizeof(last), &last, nullptr) == CL_SUCCESS)
-      timings_.kernel_ns = static_cast<double>(last - first);
-    sumAndRelease(runs, false);
-  } else {
-    timings_.kernel_ns = sumAndRelease(runs, prof);
-  }
-  timings_.readback_ns = sumAndRelease(reads, prof);
-  if (!prof) timings_.kernel_ns = wall;
-  if (!ok) {
-    clFinish(runtime_->queue());
-    uploadState();  // the device state may be half-stepped: restore the last good one
-    return false;
-  }
-  x_.swap(x_back);
-  v_stale_ = true;
-  collision_stats_.tests = stats.tests;
-  collision_stats_.contacts = stats.contacts;
-  collision_stats_.swept_catches = stats.swept_catches;
-  collision_stats_.escapes = stats.escapes;
-  return true;
-}
 
 }  // namespace drape

@@ -11,6 +11,7 @@
 #include "cloth/xpbd_solver.h"
 #include "drape_cl_types.h"
 
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
@@ -64,13 +65,18 @@ class ClXpbdSolver {
   const ClStepTimings& lastTimings() const { return timings_; }
   const std::string& lastError() const { return device_error_; }
   bool usesLocalMemory() const { return !usesPhases() && particleCount() <= runtime_->localParticles(); }
-  // How a frame runs. Auto: one work-group launch (drape_xpbd_frame) while the particles fit in
-  // __local memory, else one launch per phase over global memory (drape_phase_*: every compute
-  // unit takes part). The two give bit-identical results (tested).
+  // How a frame runs. Auto: one work-group launch (drape_xpbd_frame) for small garments (at most
+  // kWorkGroupMaxParticles and fitting in __local memory), else one launch per phase over global
+  // memory (drape_phase_*: every compute unit takes part). The two give bit-identical results
+  // (tested). The limit is measured (docs/opencl.md): on PoCL the phases already win at 7 800
+  // particles, and one work-group of 256 items cannot keep a GPU busy beyond a few thousand.
+  static constexpr size_t kWorkGroupMaxParticles = 4096;
   enum class Path { Auto, WorkGroup, Phases };
   void setPath(Path p) { path_ = p; }
   bool usesPhases() const {
-    return path_ == Path::Phases || (path_ == Path::Auto && particleCount() > runtime_->localParticles());
+    return path_ == Path::Phases ||
+           (path_ == Path::Auto &&
+            particleCount() > std::min(kWorkGroupMaxParticles, runtime_->localParticles()));
   }
   const ClRuntime& runtime() const { return *runtime_; }
 
