@@ -30,7 +30,7 @@ namespace Drape
         /// <summary>The header version these declarations were written against (DRAPE_VERSION_*).
         /// Only the major part must match the loaded library (see DrapeLibrary.EnsureCompatible).</summary>
         internal const uint HeaderVersionMajor = 0;
-        internal const uint HeaderVersionMinor = 1;
+        internal const uint HeaderVersionMinor = 2;
         internal const uint HeaderVersionPatch = 0;
 
         private const CallingConvention Cdecl = CallingConvention.Cdecl;

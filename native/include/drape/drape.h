@@ -27,7 +27,7 @@
 #include <stdint.h>
 
 #define DRAPE_VERSION_MAJOR 0
-#define DRAPE_VERSION_MINOR 1
+#define DRAPE_VERSION_MINOR 2
 #define DRAPE_VERSION_PATCH 0
 /* Packed version: major << 22 | minor << 12 | patch (as returned by drape_version()). */
 #define DRAPE_MAKE_VERSION(major, minor, patch) \

@@ -16,6 +16,7 @@ using drape::api::checkStructSize;
 using drape::api::fail;
 using drape::api::guarded;
 
+#if DRAPE_HAVE_OPENCL
 namespace {
 // Device names handed out by drape_opencl_device_get live until the process ends: each distinct
 // string is kept once (a handful per machine).
@@ -26,6 +27,7 @@ const char* intern(const std::string& s) {
   return names.insert(s).first->c_str();
 }
 }  // namespace
+#endif
 
 static_assert(sizeof(drape_backend_desc) == 24 + 2 * sizeof(void*), "drape_backend_desc layout");
 static_assert(sizeof(drape_backend_info) == 24 + 3 * sizeof(void*), "drape_backend_info layout");
@@ -114,6 +116,7 @@ DRAPE_API drape_result DRAPE_CALL drape_opencl_device_get(uint32_t index, drape_
     *out = o;
     return DRAPE_OK;
 #else
+    (void)index;
     return fail(DRAPE_ERROR_OUT_OF_RANGE, "drape_opencl_device_get: this build has no OpenCL backend (0 devices)");
 #endif
   });

@@ -71,9 +71,9 @@ void Context::applyBackend(GarmentSim& g) {
   if (!backend_) return;  // never chosen: the CPU, as created
   std::string err;
   Backend& b = *backend_;
-  bool want_cl = b.desc.backend == DRAPE_BACKEND_OPENCL ||
-                 (b.desc.backend == DRAPE_BACKEND_AUTO && g.particleCount() >= b.desc.opencl_min_particles);
 #if DRAPE_HAVE_OPENCL
+  const bool want_cl = b.desc.backend == DRAPE_BACKEND_OPENCL ||
+                       (b.desc.backend == DRAPE_BACKEND_AUTO && g.particleCount() >= b.desc.opencl_min_particles);
   if (want_cl && b.runtime && g.solver() == ClothSolverKind::Xpbd) {
     if (g.backend() == GarmentBackend::OpenCl || g.replaceSolver(clGarmentSolverFactory(b.runtime), err)) return;
     b.reason = "a garment could not move to the OpenCL device: " + err;

@@ -1,5 +1,7 @@
 #include "backends/opencl/cl_runtime.h"
 
+#include "backends/opencl/cl_frame_batch.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cstring>
@@ -117,10 +119,17 @@ std::shared_ptr<ClRuntime> ClRuntime::create(const ClChoice& choice, std::string
 }
 
 ClRuntime::~ClRuntime() {
+  batch_.reset();  // its kernel and buffers before the program and context they belong to
   if (program_) clReleaseProgram(program_);
   // Ours, or the host's that build() retained: either way one reference to release.
   if (queue_) clReleaseCommandQueue(queue_);
   if (context_) clReleaseContext(context_);
+}
+
+ClFrameBatch& ClRuntime::frameBatch() {
+  std::lock_guard<std::mutex> lock(batch_mutex_);
+  if (!batch_) batch_ = std::make_unique<ClFrameBatch>(*this);
+  return *batch_;
 }
 
 bool ClRuntime::build(const ClChoice& choice, std::string& err) {

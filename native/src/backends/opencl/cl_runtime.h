@@ -8,12 +8,16 @@
 
 #include <CL/cl.h>
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
 namespace drape {
+
+class ClFrameBatch;
 
 struct ClDeviceDesc {
   int platform = 0, device = 0;  // indices as enumerated
@@ -59,6 +63,14 @@ class ClRuntime {
   size_t workGroup() const { return work_group_; }
   double buildMs() const { return build_ms_; }
 
+  // Kernel launches enqueued on this runtime's queue since it was created (every launch site
+  // counts itself): tests check that a batched frame costs the same launches for 1 or N garments.
+  uint64_t launchCount() const { return launches_.load(); }
+  void countLaunches(uint64_t n = 1) { launches_ += n; }
+  // The frame batcher of this runtime (cl_frame_batch.h), made on first use; its buffers grow to
+  // the largest batch seen.
+  ClFrameBatch& frameBatch();
+
  private:
   ClRuntime() = default;
   bool build(const ClChoice& choice, std::string& err);
@@ -71,6 +83,9 @@ class ClRuntime {
   std::string device_name_, platform_name_;
   size_t local_particles_ = 1, work_group_ = 64;
   double build_ms_ = 0.0;
+  std::atomic<uint64_t> launches_{0};
+  std::mutex batch_mutex_;
+  std::unique_ptr<ClFrameBatch> batch_;
 };
 
 }  // namespace drape

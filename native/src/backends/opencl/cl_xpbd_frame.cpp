@@ -46,6 +46,7 @@ bool ClXpbdSolver::enqueuePhases(const DrapeClGarment& g, std::vector<cl_event>&
     const size_t global = (items + 63) / 64 * 64;
     cl_event e = nullptr;
     rc = clEnqueueNDRangeKernel(q, k, 1, nullptr, &global, nullptr, 0, nullptr, keep_event ? &e : nullptr);
+    runtime_->countLaunches();
     if (rc == CL_SUCCESS && keep_event) runs.push_back(e);
   };
   auto arg = [&](cl_kernel k, cl_uint i, auto v) {
@@ -185,6 +186,7 @@ bool ClXpbdSolver::step(float dt, int substeps) {
     const size_t wg = runtime_->workGroup();
     cl_event e = nullptr;
     rc = clEnqueueNDRangeKernel(runtime_->queue(), frame_, 1, nullptr, &wg, &wg, 0, nullptr, &e);
+    runtime_->countLaunches();
     if (rc == CL_SUCCESS) {
       runs.push_back(e);
     } else {

@@ -266,6 +266,7 @@ void ClXpbdSolver::transform(const Mat3& R, const Vec3& pivot, const Vec3& t, fl
   const size_t wg = 64, global = (particleCount() + wg - 1) / wg * wg;
   if (rc == CL_SUCCESS)
     rc = clEnqueueNDRangeKernel(runtime_->queue(), transform_, 1, nullptr, &global, &wg, 0, nullptr, nullptr);
+    runtime_->countLaunches();
   if (rc != CL_SUCCESS) {
     // Keep host and device consistent: the host copy (already moved) goes to the device.
     device_error_ = std::string("transform kernel failed (") + clErrorName(rc) + ")";
