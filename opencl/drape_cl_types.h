@@ -72,6 +72,14 @@ typedef struct {
   float rest, inv_w;
 } DrapeClConstraint;
 
+/* The rigid carry of one garment in a batched drape_transform_batch launch: x -> R (x - pivot)
+ * + shift, v -> vscale R v over particles [offset, offset + count) (R by columns). */
+typedef struct {
+  dcl_f4 r0, r1, r2, pivot, shift;
+  float vscale;
+  dcl_u32 offset, count, pad;
+} DrapeClTransform;
+
 /* Collision counters of one garment for the last frame (CollisionStats). */
 typedef struct {
   dcl_u32 tests, contacts, swept_catches, escapes;

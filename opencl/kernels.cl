@@ -127,6 +127,23 @@ __kernel void drape_transform(__global float4* x, __global float4* v, uint count
   v[i] = (float4)(vscale * (r0.xyz * u.x + r1.xyz * u.y + r2.xyz * u.z), 0.0f);
 }
 
+/* drape_transform for every garment of a batch (work-group g = table entry g), the same
+ * arithmetic per particle, so batched and lone garments move the same bits. */
+__kernel void drape_transform_batch(__global float4* x, __global float4* v,
+                                    __global const DrapeClTransform* table) {
+  __global const DrapeClTransform* m = table + get_group_id(0);
+  const float4 r0 = m->r0, r1 = m->r1, r2 = m->r2, pivot = m->pivot, shift = m->shift;
+  const float vscale = m->vscale;
+  for (uint k = get_local_id(0); k < m->count; k += get_local_size(0)) {
+    const uint i = m->offset + k;
+    const float4 p = x[i];
+    const float3 d = p.xyz - pivot.xyz;
+    x[i] = (float4)(r0.xyz * d.x + r1.xyz * d.y + r2.xyz * d.z + shift.xyz, p.w);
+    const float3 u = v[i].xyz;
+    v[i] = (float4)(vscale * (r0.xyz * u.x + r1.xyz * u.y + r2.xyz * u.z), 0.0f);
+  }
+}
+
 /* ---- Large garments: the same frame as drape_xpbd_frame, one launch per phase over global
  * memory with one work-item per particle (or constraint), so every compute unit takes part.
  * Per substep: drape_phase_predict, drape_phase_pins, one drape_project_group per colour group

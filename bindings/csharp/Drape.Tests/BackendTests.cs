@@ -59,6 +59,58 @@ namespace Drape.Tests
             Assert.NotEqual("", s.FallbackReason);
         }
 
+        private static (Context, Garment) Person(Backend backend)
+        {
+            var ctx = new Context();
+            GarmentTemplate t = GarmentTemplate.CreateDefault(GarmentKind.TShirt);
+            t.Particles = 400;
+            Garment g = ctx.AddGarment(t);
+            BackendDesc d = BackendDesc.CreateDefault();
+            d.Backend = backend;
+            ctx.SetBackend(d);
+            return (ctx, g);
+        }
+
+        [Fact]
+        public void StepAllMatchesSteppingEachContext()
+        {
+            // On the device when there is one (batched launches), else on the CPU: the same either way.
+            var (a, ga) = Person(Backend.OpenCl);
+            var (b, gb) = Person(Backend.OpenCl);
+            var (c, gc) = Person(Backend.OpenCl);
+            var (d, gd) = Person(Backend.OpenCl);
+            using (a) using (b) using (c) using (d)
+            {
+                for (int i = 0; i < 4; ++i)
+                {
+                    foreach (Context x in new[] { a, b, c, d })
+                        x.PushSkeleton(SyntheticKinect2.Frame(i), Layout.Kinect2, SyntheticKinect2.Time(i));
+                    Context.StepAll(new[] { a, b }, 1.0f / 30.0f);
+                    c.Step(1.0f / 30.0f);
+                    d.Step(1.0f / 30.0f);
+                }
+                Assert.Equal(gc.ViewPositions().ToArray(), ga.ViewPositions().ToArray());
+                Assert.Equal(gd.ViewPositions().ToArray(), gb.ViewPositions().ToArray());
+                Assert.Equal(4ul, ga.Stats.Steps);
+
+                // Rejected calls step nothing.
+                float[] before = ga.ViewPositions().ToArray();
+                Assert.Throws<ArgumentNullException>(() => Context.StepAll(null!, 1.0f / 30.0f));
+                Assert.Throws<ArgumentNullException>(() => Context.StepAll(new Context[] { a, null! }, 1.0f / 30.0f));
+                Assert.Equal(ResultCode.OutOfRange,
+                    Assert.Throws<DrapeException>(() => Context.StepAll(Array.Empty<Context>(), 1.0f / 30.0f)).Code);
+                Assert.Equal(ResultCode.InvalidArgument,
+                    Assert.Throws<DrapeException>(() => Context.StepAll(new[] { a, b, a }, 1.0f / 30.0f)).Code);
+                Assert.Equal(ResultCode.NonFinite,
+                    Assert.Throws<DrapeException>(() => Context.StepAll(new[] { a, b }, float.NaN)).Code);
+                using var fresh = new Context();  // no skeleton frame yet
+                Assert.Equal(ResultCode.CallOrder,
+                    Assert.Throws<DrapeException>(() => Context.StepAll(new[] { a, fresh }, 1.0f / 30.0f)).Code);
+                Assert.Equal(before, ga.ViewPositions().ToArray());
+                Assert.Equal(4ul, ga.Stats.Steps);
+            }
+        }
+
         [Fact]
         public void GarmentStepsOnOpenClWhenADeviceExists()
         {

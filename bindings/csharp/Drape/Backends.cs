@@ -165,6 +165,35 @@ namespace Drape
             DrapeException.Check(Native.drape_context_set_backend(h, &d));
         }
 
+        /// <summary>DRAPE_MAX_STEP_CONTEXTS: the most contexts one <see cref="StepAll"/> takes.</summary>
+        public const int MaxStepContexts = 64;
+
+        /// <summary>
+        /// Steps several contexts (people) by <paramref name="dt"/> together (drape_step_contexts):
+        /// the same as <see cref="Step"/> on each in order, with the same results, but the OpenCL
+        /// garments of contexts on one device run their frame in the same launches. Every context
+        /// is checked first: when the call throws a <see cref="DrapeException"/> none stepped.
+        /// Null, repeated, disposed contexts and a count outside [1, <see cref="MaxStepContexts"/>]
+        /// are rejected.
+        /// </summary>
+        public static void StepAll(IReadOnlyList<Context> contexts, float dt)
+        {
+            if (contexts == null) throw new ArgumentNullException(nameof(contexts));
+            int n = contexts.Count;
+            // Past the limit the native call rejects the count; the array still has to exist.
+            IntPtr[] handles = new IntPtr[Math.Max(n, 1)];
+            for (int i = 0; i < n; ++i)
+            {
+                if (contexts[i] == null) throw new ArgumentNullException(nameof(contexts), $"contexts[{i}] is null");
+                handles[i] = contexts[i].Live;
+            }
+            fixed (IntPtr* p = handles)
+            {
+                DrapeException.Check(Native.drape_step_contexts(p, (uint)n, dt));
+            }
+            for (int i = 0; i < n; ++i) GC.KeepAlive(contexts[i]);
+        }
+
         /// <summary>The backend in use (drape_context_get_backend_info), strings copied.</summary>
         public BackendStatus GetBackendInfo()
         {

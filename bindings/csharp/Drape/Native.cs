@@ -263,6 +263,9 @@ namespace Drape
 
         [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
         internal static extern ResultCode drape_opencl_device_get(uint index, OpenClDeviceInfo* outDevice);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_step_contexts(IntPtr* contexts, uint count, float dt);
     }
 
     /// <summary>UTF-8 conversions for the C ABI's <c>const char*</c>, without any marshaller.</summary>

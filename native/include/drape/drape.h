@@ -781,6 +781,18 @@ typedef struct drape_opencl_device {
   const char* device_name;
 } drape_opencl_device;
 
+/* Steps several contexts (people) by dt together: the same as drape_context_step on each in
+ * order, with the same results bit for bit, but the OpenCL garments of every context that use
+ * one device run their frame in the same launches (one batched launch for the garments small
+ * enough for one work-group; docs/opencl.md, "Batching"), so N people cost about the launches
+ * and transfers of one. contexts: count distinct live contexts, count in [1, 64]; dt as
+ * drape_context_step. Every argument and every context's call order is checked before any
+ * context steps: a rejected call changes nothing. Thread-safety: the calling thread must be the
+ * only one using these contexts during the call. */
+#define DRAPE_MAX_STEP_CONTEXTS 64
+DRAPE_API drape_result DRAPE_CALL drape_step_contexts(drape_context* const* contexts, uint32_t count,
+                                                      float dt);
+
 /* Number of OpenCL devices: 0 (DRAPE_OK) without an OpenCL driver or in a build without OpenCL. */
 DRAPE_API drape_result DRAPE_CALL drape_opencl_device_count(uint32_t* out_count);
 DRAPE_API drape_result DRAPE_CALL drape_opencl_device_get(uint32_t index, drape_opencl_device* out_device);

@@ -10,6 +10,7 @@
 #include <mutex>
 #include <set>
 #include <string>
+#include <vector>
 
 using drape::Context;
 using drape::api::checkStructSize;
@@ -119,5 +120,31 @@ DRAPE_API drape_result DRAPE_CALL drape_opencl_device_get(uint32_t index, drape_
     (void)index;
     return fail(DRAPE_ERROR_OUT_OF_RANGE, "drape_opencl_device_get: this build has no OpenCL backend (0 devices)");
 #endif
+  });
+}
+
+DRAPE_API drape_result DRAPE_CALL drape_step_contexts(drape_context* const* contexts, uint32_t count, float dt) {
+  return guarded("drape_step_contexts", [&]() -> drape_result {
+    if (!contexts) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_step_contexts: contexts is NULL");
+    if (count == 0 || count > DRAPE_MAX_STEP_CONTEXTS)
+      return fail(DRAPE_ERROR_OUT_OF_RANGE, "drape_step_contexts: count = " + std::to_string(count) +
+                                                " is outside [1, " + std::to_string(DRAPE_MAX_STEP_CONTEXTS) + "]");
+    std::vector<Context*> resolved(count);
+    for (uint32_t i = 0; i < count; ++i) {
+      const std::string at = "drape_step_contexts: contexts[" + std::to_string(i) + "]";
+      if (!contexts[i]) return fail(DRAPE_ERROR_NULL_ARGUMENT, at + " is NULL");
+      resolved[i] = static_cast<Context*>(
+          drape::api::resolveHandle(drape::api::HandleKind::Context, contexts[i]));
+      if (!resolved[i])
+        return fail(DRAPE_ERROR_INVALID_HANDLE, at + " is not a live drape_context (destroyed or never created)");
+      for (uint32_t j = 0; j < i; ++j)
+        if (resolved[j] == resolved[i])
+          return fail(DRAPE_ERROR_INVALID_ARGUMENT,
+                      at + " repeats contexts[" + std::to_string(j) + "] (each context steps once)");
+    }
+    std::string err;
+    if (drape_result r = Context::stepContexts(resolved.data(), resolved.size(), dt, err))
+      return fail(r, "drape_step_contexts: " + err);
+    return DRAPE_OK;
   });
 }

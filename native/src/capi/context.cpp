@@ -339,6 +339,11 @@ bool Context::removeGarment(const GarmentSim* garment) {
 }
 
 drape_result Context::step(float dt, std::string& err) {
+  Context* self = this;
+  return stepContexts(&self, 1, dt, err);
+}
+
+drape_result Context::checkStep(float dt, std::string& err) const {
   if (!std::isfinite(dt)) {
     err = "dt is not finite";
     return DRAPE_ERROR_NONFINITE;
@@ -351,8 +356,12 @@ drape_result Context::step(float dt, std::string& err) {
     err = "no skeleton frame has been accepted yet (call drape_context_push_skeleton first)";
     return DRAPE_ERROR_CALL_ORDER;
   }
+  return DRAPE_OK;
+}
+
+drape_result Context::beginStep(float dt, std::string& err) {
   if (drape_result r = update(err)) return r;
-  const auto t0 = Clock::now();
+  stepT0_ = Clock::now();
   // Woken or new garments, or new options, since the frame's ellipsoids were built.
   if (reachDirty_ && updated_) buildProxies(tracker_.pose());
   const std::vector<Ellipsoid>& now = proxies_.ellipsoids();
@@ -363,6 +372,7 @@ drape_result Context::step(float dt, std::string& err) {
     if (fresh_[k] && !(k < freshAtStep_.size() && freshAtStep_[k])) stepEllipsoids_[k] = now[k];
   adaptive_.advance(dt);
   size_t slept = 0;
+  stepping_.clear();
   for (auto& g : garments_) {
     if (options_.sleep && adaptive_.asleep(g.get())) {
       g->markSkipped();
@@ -370,9 +380,24 @@ drape_result Context::step(float dt, std::string& err) {
       continue;
     }
     const std::vector<Ellipsoid>* woke = adaptive_.wakeStart(g.get(), now);
-    g->step(*body_, woke ? *woke : stepEllipsoids_, now, dt, teleportPending_);
+    // Device frames are only staged here: the caller runs them all together (runStagedFrames).
+    g->stepBegin(*body_, woke ? *woke : stepEllipsoids_, now, dt, teleportPending_, true);
+    stepping_.push_back(g.get());
+  }
+  stepDt_ = dt;
+  stepSlept_ = slept;
+  return DRAPE_OK;
+}
+
+void Context::endStep() {
+  const float dt = stepDt_;
+  const size_t slept = stepSlept_;
+  const std::vector<Ellipsoid>& now = proxies_.ellipsoids();
+  for (GarmentSim* g : stepping_) {
+    g->stepEnd();
     adaptive_.afterStep(*g, now, dt, options_);
   }
+  stepping_.clear();
   checkDeviceFailures();
   clothSkippedLast_ = slept > 0;
   if (!garments_.empty()) {
@@ -384,8 +409,29 @@ drape_result Context::step(float dt, std::string& err) {
   teleportPending_ = false;
   stepEllipsoids_ = now;
   freshAtStep_ = fresh_;
-  stepMs_ = msSince(t0);
-  return DRAPE_OK;
+  stepMs_ = msSince(stepT0_);
+}
+
+drape_result Context::stepContexts(Context* const* contexts, size_t count, float dt, std::string& err) {
+  // Every check first: a rejected call changes nothing.
+  for (size_t i = 0; i < count; ++i)
+    if (drape_result r = contexts[i]->checkStep(dt, err)) return r;
+  drape_result result = DRAPE_OK;
+  size_t begun = 0;
+  for (; begun < count; ++begun) {
+    if ((result = contexts[begun]->beginStep(dt, err)) != DRAPE_OK) break;
+  }
+  // The contexts that began finish their step even when a later one failed to begin.
+  if (count == 1) {
+    if (begun == 1) runStagedFrames(contexts[0]->stepping_);  // drape_context_step: no gathering
+  } else {
+    std::vector<GarmentSim*> staged;
+    for (size_t i = 0; i < begun; ++i)
+      staged.insert(staged.end(), contexts[i]->stepping_.begin(), contexts[i]->stepping_.end());
+    runStagedFrames(staged);
+  }
+  for (size_t i = 0; i < begun; ++i) contexts[i]->endStep();
+  return result;
 }
 
 GarmentAccuracy Context::measureGarment(const GarmentSim& garment) {

@@ -60,6 +60,10 @@ class Context {
   GarmentSim& garment(size_t i) { return *garments_[i]; }
   // Runs update() if a frame is queued, then advances every garment by dt (seconds, (0, 10]).
   drape_result step(float dt, std::string& err);
+  // drape_step_contexts: step() of each, their OpenCL garments' frames run together (one batched
+  // launch per device: docs/opencl.md). Every context is checked first (a rejected call changes
+  // nothing); contexts must be distinct (the caller checks).
+  static drape_result stepContexts(Context* const* contexts, size_t count, float dt, std::string& err);
   // Accuracy of a garment now, against the ellipsoids and the body mesh of the last update.
   GarmentAccuracy measureGarment(const GarmentSim& garment);
   double lastStepMs() const { return stepMs_; }
@@ -114,6 +118,16 @@ class Context {
   std::string infoDevice_, infoPlatform_, infoReason_;  // backendInfo() strings
   void applyBackend(GarmentSim& garment);
   void checkDeviceFailures();
+  // step() in parts (stepContexts): the checks, the garments' host halves (device frames staged),
+  // then after every staged frame ran (runStagedFrames, context_backend.cpp), the other halves.
+  drape_result checkStep(float dt, std::string& err) const;
+  drape_result beginStep(float dt, std::string& err);
+  void endStep();
+  static void runStagedFrames(const std::vector<GarmentSim*>& garments);
+  std::vector<GarmentSim*> stepping_;  // begun, not yet ended
+  float stepDt_ = 0.0f;
+  size_t stepSlept_ = 0;
+  std::chrono::steady_clock::time_point stepT0_{};
 
   uint32_t pushed_ = 0, accepted_ = 0, rejected_ = 0, dropped_ = 0, updates_ = 0;
   bool teleported_ = false;

@@ -84,6 +84,14 @@ void Context::applyBackend(GarmentSim& g) {
   if (!g.useCpuSolver(err) && b.reason.empty()) b.reason = "moving a garment back to the CPU failed: " + err;
 }
 
+void Context::runStagedFrames(const std::vector<GarmentSim*>& garments) {
+#if DRAPE_HAVE_OPENCL
+  runStagedClFrames(garments);
+#else
+  (void)garments;  // nothing is staged without a device solver
+#endif
+}
+
 void Context::checkDeviceFailures() {
   for (auto& g : garments_) {
     std::string why;

@@ -334,7 +334,16 @@ void GarmentSim::runFrame(const std::vector<Ellipsoid>& start, const std::vector
   solver_->setMotion(&collider_, start, end, params_.collision_margin_m, err);
   const float sim = std::min(dt, params_.max_step_s);
   const int n = std::clamp(static_cast<int>(std::ceil(sim * params_.substep_hz - 1e-3f)), 1, params_.max_substeps);
+  if (staging_ && solver_->stageStep(sim, n)) {
+    staged_ = true;  // the caller runs it (with other garments' frames) before stepEnd()
+    staged_substeps_ = n;
+    return;
+  }
   solver_->step(sim, n);
+  addFrameStats(n);
+}
+
+void GarmentSim::addFrameStats(int n) {
   last_.substeps += n;
   last_.collide_ms += solver_->collideMs();
   const CollisionStats c = solver_->collision();
@@ -390,25 +399,42 @@ const std::vector<Ellipsoid>& GarmentSim::pickReachable(const std::vector<Ellips
 
 void GarmentSim::step(const BodyModel& body, const std::vector<Ellipsoid>& start_all,
                       const std::vector<Ellipsoid>& end_all, float dt, bool teleported) {
+  stepBegin(body, start_all, end_all, dt, teleported, false);
+  stepEnd();
+}
+
+void GarmentSim::runStepFrame(const std::vector<Ellipsoid>& start, const std::vector<Ellipsoid>& end,
+                              const std::vector<Vec3>& pins, float dt) {
+  staging_ = allow_staging_;
+  runFrame(start, end, pins, dt);
+  staging_ = false;
+}
+
+void GarmentSim::stepBegin(const BodyModel& body, const std::vector<Ellipsoid>& start_all,
+                           const std::vector<Ellipsoid>& end_all, float dt, bool teleported, bool allow_staging) {
+  allow_staging_ = allow_staging;
+  staged_ = false;
   const std::vector<Ellipsoid>& start = pickReachable(start_all, reach_start_);
   const std::vector<Ellipsoid>& end = pickReachable(end_all, reach_end_);
-  const auto t0 = Clock::now();
+  pending_t0_ = Clock::now();
   last_ = GarmentStepStats{};
   pins_.resize(mesh_.pinned.size());
   const RingPose& pr = body.rings()[static_cast<size_t>(pelvis_ring_)];
+  pending_body_ = &body;
+  pending_end_ = &end;
   if (!tracked_ || poseJumped(pr, dt)) {
     // First frame, or a pose no body reaches in dt from the last one (a skeleton flipped upside
     // down for a frame): the garment is put where the body's rings carry its dressed shape.
     last_.teleport_reset = tracked_;
     placeOnBody(body, end);
     tracked_ = true;
-    runFrame(end, end, pins_, dt);
+    runStepFrame(end, end, pins_, dt);
   } else if (teleported) {
     // The person is somewhere else in the same pose: move the garment with them, at rest.
     last_.teleport_reset = true;
     carry(pr.frame * seen_pelvis_f_.transpose(), seen_pelvis_c_, pr.centre - seen_pelvis_c_, 0.0f);
     pinTargets(body, pins_);
-    runFrame(end, end, pins_, dt);
+    runStepFrame(end, end, pins_, dt);
   } else {
     // Inertia scaling: the part of the pelvis' rigid motion the garment does not feel moves it.
     // The body's start-of-step ellipsoids are carried by the same transform, so garment and body
@@ -428,12 +454,22 @@ void GarmentSim::step(const BodyModel& body, const std::vector<Ellipsoid>& start
         carried_start_[k] = e;
       }
       pinTargets(body, pins_);
-      runFrame(carried_start_, end, pins_, dt);
+      runStepFrame(carried_start_, end, pins_, dt);
     } else {
       pinTargets(body, pins_);
-      runFrame(start, end, pins_, dt);
+      runStepFrame(start, end, pins_, dt);
     }
   }
+  allow_staging_ = false;
+}
+
+void GarmentSim::stepEnd() {
+  // The staged frame (if any) has run: its statistics now, as runFrame counts an unstaged one.
+  if (staged_) addFrameStats(staged_substeps_);
+  staged_ = false;
+  const BodyModel& body = *pending_body_;
+  const std::vector<Ellipsoid>& end = *pending_end_;
+  const RingPose& pr = body.rings()[static_cast<size_t>(pelvis_ring_)];
   // NaN guard (cannot happen with validated input; if it does, never hand NaN to the host).
   const Eigen::Vector4f* x = solver_->x();
   for (size_t i = 0; i < particleCount(); ++i) {
@@ -446,7 +482,7 @@ void GarmentSim::step(const BodyModel& body, const std::vector<Ellipsoid>& start
   seen_pelvis_c_ = pr.centre;
   seen_pelvis_f_ = pr.frame;
   ++steps_;
-  last_.total_ms = msSince(t0);
+  last_.total_ms = msSince(pending_t0_);
 }
 
 const std::vector<Vec3>& GarmentSim::normals() const {

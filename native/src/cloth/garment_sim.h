@@ -24,6 +24,7 @@
 #include "proxies/collision.h"
 #include "proxies/mesh_bvh.h"
 
+#include <chrono>
 #include <functional>
 #include <memory>
 #include <string>
@@ -111,6 +112,16 @@ class GarmentSim {
   // dt must be finite and > 0 (checked by the caller); ellipsoid counts must match creation's.
   void step(const BodyModel& body, const std::vector<Ellipsoid>& start,
             const std::vector<Ellipsoid>& end, float dt, bool teleported);
+  // step() in two halves, so that a context can run many garments' device frames in one launch
+  // (docs/opencl.md, "Batching"): stepBegin is the host part (inertia carry, pins, teleports and
+  // pose jumps, the ellipsoid spans) and runs the frame, except that with allow_staging a device
+  // solver may only stage it: the caller then runs every staged frame (runStagedClFrames) before
+  // stepEnd, the NaN guard and bookkeeping. body and end must live until stepEnd.
+  // step() = stepBegin without staging + stepEnd: the same results either way.
+  void stepBegin(const BodyModel& body, const std::vector<Ellipsoid>& start,
+                 const std::vector<Ellipsoid>& end, float dt, bool teleported, bool allow_staging);
+  void stepEnd();
+  bool frameStaged() const { return staged_; }
 
   size_t particleCount() const;
   const Eigen::Vector4f* positions() const;   // xyz metres, w = inverse mass (0 = pinned)
@@ -147,6 +158,7 @@ class GarmentSim {
   GarmentAccuracy measure(const std::vector<Ellipsoid>& ellipsoids, const TriangleBvh* body_bvh) const;
 
   struct Solver;  // the solver behind the garment (cloth/garment_solver.h)
+  Solver* solverFace() { return solver_.get(); }
 
   // Backends (docs/opencl.md). A factory builds a solver from the garment's topology, its state
   // now (particleCount() positions and velocities, xyzw) and its collision masks.
@@ -171,6 +183,16 @@ class GarmentSim {
   void pinTargets(const BodyModel& body, std::vector<Vec3>& out) const;
   void runFrame(const std::vector<Ellipsoid>& start, const std::vector<Ellipsoid>& end,
                 const std::vector<Vec3>& pins, float dt);
+  // runFrame for the step's own frame: staged when stepBegin allows it (never while dressing
+  // or settling in placeOnBody).
+  void runStepFrame(const std::vector<Ellipsoid>& start, const std::vector<Ellipsoid>& end,
+                    const std::vector<Vec3>& pins, float dt);
+  void addFrameStats(int substeps);  // a frame's substeps and collision counters into last_
+  bool allow_staging_ = false, staging_ = false, staged_ = false;
+  int staged_substeps_ = 0;
+  const BodyModel* pending_body_ = nullptr;  // stepBegin's arguments, for stepEnd
+  const std::vector<Ellipsoid>* pending_end_ = nullptr;
+  std::chrono::steady_clock::time_point pending_t0_{};
   // The pelvis turned farther since the last step than a person can turn in dt.
   bool poseJumped(const RingPose& pelvis, float dt) const;
   void carry(const Mat3& R, const Vec3& pivot, const Vec3& t, float velocity_scale);

@@ -16,6 +16,10 @@ struct GarmentSim::Solver {
   virtual bool setMotion(EllipsoidCollider* c, const std::vector<Ellipsoid>& a,
                          const std::vector<Ellipsoid>& b, float margin, std::string& err) = 0;
   virtual void step(float dt, int substeps) = 0;
+  // Batching (GarmentSim::stepBegin): a solver that can run its frame later together with other
+  // garments' prepares it and returns true; the caller runs it before reading the state. False
+  // (the CPU solvers): step() runs now.
+  virtual bool stageStep(float /*dt*/, int /*substeps*/) { return false; }
   virtual bool reset(const std::vector<Vec3>& x, std::string& err) = 0;
   virtual void transform(const Mat3& R, const Vec3& pivot, const Vec3& t, float vscale) = 0;
   virtual const Eigen::Vector4f* x() const = 0;

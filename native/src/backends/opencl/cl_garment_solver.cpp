@@ -1,7 +1,11 @@
 #include "backends/opencl/cl_garment_solver.h"
 
+#include "backends/opencl/cl_frame_batch.h"
 #include "backends/opencl/cl_xpbd_solver.h"
 #include "cloth/garment_solver.h"
+
+#include <algorithm>
+#include <atomic>
 
 namespace drape {
 namespace {
@@ -25,6 +29,20 @@ struct ClXpbdFace final : GarmentSim::Solver {
       failed = true;
       error = s->lastError();
     }
+  }
+  bool stageStep(float dt, int substeps) override {
+    flush();
+    staged = s->prepareFrame(dt, substeps);  // false: bad arguments, nothing runs (as step())
+    return true;
+  }
+  // The staged frame alone (runStagedClFrames batches the others).
+  void runStaged() {
+    staged = false;
+    if (!s->runPreparedFrame() && !s->lastError().empty()) fail(s->lastError());
+  }
+  void fail(const std::string& why) {
+    failed = true;
+    error = why;
   }
   bool reset(const std::vector<Vec3>& x, std::string& err) override {
     dirty = false;
@@ -58,11 +76,60 @@ struct ClXpbdFace final : GarmentSim::Solver {
   }
 
   std::unique_ptr<ClXpbdSolver> s;
-  bool dirty = false, failed = false;
+  bool dirty = false, failed = false, staged = false;
   std::string error;
 };
 
 }  // namespace
+
+namespace {
+std::atomic<bool> g_batching{true};
+}  // namespace
+
+void setClFrameBatching(bool on) { g_batching = on; }
+bool clFrameBatching() { return g_batching.load(); }
+
+size_t runStagedClFrames(const std::vector<GarmentSim*>& garments) {
+  // Group the staged device frames by runtime; a group's one-work-group frames run as one batch
+  // when there are two or more, the rest (per-phase garments, a lone garment) alone.
+  std::vector<std::pair<ClRuntime*, std::vector<ClXpbdFace*>>> by_runtime;
+  for (GarmentSim* g : garments) {
+    auto* face = g ? dynamic_cast<ClXpbdFace*>(g->solverFace()) : nullptr;
+    if (!face || !face->staged) continue;
+    ClRuntime* rt = const_cast<ClRuntime*>(&face->s->runtime());
+    auto it = std::find_if(by_runtime.begin(), by_runtime.end(), [&](const auto& p) { return p.first == rt; });
+    if (it == by_runtime.end()) {
+      by_runtime.emplace_back(rt, std::vector<ClXpbdFace*>{});
+      it = by_runtime.end() - 1;
+    }
+    it->second.push_back(face);
+  }
+  size_t batched = 0;
+  for (auto& [rt, faces] : by_runtime) {
+    std::vector<ClXpbdFace*> together;
+    for (ClXpbdFace* f : faces) {
+      if (f->s->particleCount() > 0 && !f->s->usesPhases()) {
+        together.push_back(f);
+      } else {
+        f->runStaged();
+      }
+    }
+    if (together.size() < 2 || !clFrameBatching()) {
+      for (ClXpbdFace* f : together) f->runStaged();
+      continue;
+    }
+    std::vector<ClXpbdSolver*> solvers;
+    for (ClXpbdFace* f : together) solvers.push_back(f->s.get());
+    std::string err;
+    const bool ok = rt->frameBatch().run(solvers, err);
+    for (ClXpbdFace* f : together) {
+      f->staged = false;
+      if (!ok) f->fail(err);
+    }
+    if (ok) batched += together.size();
+  }
+  return batched;
+}
 
 GarmentSim::SolverFactory clGarmentSolverFactory(std::shared_ptr<ClRuntime> runtime) {
   return [runtime](const GarmentTopology& t, const Eigen::Vector4f* x, const Eigen::Vector4f* v,

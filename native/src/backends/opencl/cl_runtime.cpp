@@ -126,6 +126,11 @@ ClRuntime::~ClRuntime() {
   if (context_) clReleaseContext(context_);
 }
 
+std::atomic<uint64_t>& ClRuntime::processLaunches() {
+  static std::atomic<uint64_t> launches{0};
+  return launches;
+}
+
 ClFrameBatch& ClRuntime::frameBatch() {
   std::lock_guard<std::mutex> lock(batch_mutex_);
   if (!batch_) batch_ = std::make_unique<ClFrameBatch>(*this);

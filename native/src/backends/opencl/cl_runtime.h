@@ -66,7 +66,12 @@ class ClRuntime {
   // Kernel launches enqueued on this runtime's queue since it was created (every launch site
   // counts itself): tests check that a batched frame costs the same launches for 1 or N garments.
   uint64_t launchCount() const { return launches_.load(); }
-  void countLaunches(uint64_t n = 1) { launches_ += n; }
+  void countLaunches(uint64_t n = 1) {
+    launches_ += n;
+    processLaunches() += n;
+  }
+  // Launches on every runtime of the process (tests reach contexts' runtimes only through this).
+  static uint64_t processLaunchCount() { return processLaunches().load(); }
   // The frame batcher of this runtime (cl_frame_batch.h), made on first use; its buffers grow to
   // the largest batch seen.
   ClFrameBatch& frameBatch();
@@ -74,6 +79,7 @@ class ClRuntime {
  private:
   ClRuntime() = default;
   bool build(const ClChoice& choice, std::string& err);
+  static std::atomic<uint64_t>& processLaunches();
 
   cl_context context_ = nullptr;
   cl_command_queue queue_ = nullptr;

@@ -90,11 +90,15 @@ bool ClXpbdSolver::enqueuePhases(const DrapeClGarment& g, std::vector<cl_event>&
   return true;
 }
 
-bool ClXpbdSolver::step(float dt, int substeps) {
+bool ClXpbdSolver::step(float dt, int substeps) { return prepareFrame(dt, substeps) && runPreparedFrame(); }
+
+bool ClXpbdSolver::prepareFrame(float dt, int substeps) {
+  prepared_ = false;
   if (!(dt > 0.0f) || !(dt <= 1.0f) || substeps < 1 || substeps > 1000) return false;
   timings_ = ClStepTimings{};
   collision_stats_ = CollisionStats{};
   const size_t n = particleCount();
+  prepared_ = true;
   if (n == 0) return true;
   const auto host0 = Clock::now();
   const float h = dt / static_cast<float>(substeps);
@@ -113,7 +117,8 @@ bool ClXpbdSolver::step(float dt, int substeps) {
     pin_target4_[k] = DclF4{pin_target_[k].x(), pin_target_[k].y(), pin_target_[k].z(), 0.0f};
 
   const XpbdParams& p = params_;
-  DrapeClGarment g{};
+  DrapeClGarment& g = frame_g_;
+  g = DrapeClGarment{};
   g.hg = DclF4{h * p.gravity.x(), h * p.gravity.y(), h * p.gravity.z(), 0.0f};
   g.wind = DclF4{p.wind.x(), p.wind.y(), p.wind.z(), 0.0f};
   g.particle_offset = 0;
@@ -149,6 +154,16 @@ bool ClXpbdSolver::step(float dt, int substeps) {
   g.kinetic_friction = cp.kinetic_friction > 0.0f ? std::min(cp.kinetic_friction, 1e6f) : 0.0f;
   g.max_escape = cp.max_escape_m;
   timings_.host_ns = std::chrono::duration<double, std::nano>(Clock::now() - host0).count();
+  return true;
+}
+
+bool ClXpbdSolver::runPreparedFrame() {
+  if (!prepared_) return false;
+  prepared_ = false;
+  const size_t n = particleCount();
+  if (n == 0) return true;
+  flushTransform();
+  const DrapeClGarment& g = frame_g_;
 
   // Grow the shape buffers (rare: more substeps or ellipsoids than before).
   cl_int rc = CL_SUCCESS;

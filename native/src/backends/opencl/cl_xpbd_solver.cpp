@@ -3,6 +3,7 @@
 #include "backends/opencl/cl_shapes.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <utility>
 
@@ -42,6 +43,8 @@ std::unique_ptr<ClXpbdSolver> ClXpbdSolver::create(std::shared_ptr<ClRuntime> ru
     return nullptr;
   }
   std::unique_ptr<ClXpbdSolver> s(new ClXpbdSolver());
+  static std::atomic<uint64_t> next_id{1};
+  s->batch_id_ = next_id++;
   s->runtime_ = std::move(runtime);
   s->topology_ = std::move(topology);
   s->masks_ = std::move(masks);
@@ -177,6 +180,7 @@ bool ClXpbdSolver::upload(cl_mem buffer, const void* data, size_t bytes, std::ve
 }
 
 bool ClXpbdSolver::uploadState() {
+  flushTransform();  // then overwritten: the device ends as the host copy, as before deferral
   if (particleCount() == 0) return true;
   const size_t bytes = particleCount() * 16;
   v_stale_ = false;
@@ -184,6 +188,7 @@ bool ClXpbdSolver::uploadState() {
 }
 
 bool ClXpbdSolver::pushPositions() {
+  flushTransform();  // the velocities still need it
   if (particleCount() == 0) return true;
   return upload(x_buf_, x_.data(), particleCount() * 16, nullptr);
 }
@@ -214,6 +219,7 @@ void ClXpbdSolver::refreshInvW(float inv_h2) {
   }
   inv_w_h2_ = inv_h2;
   constraints_dirty_ = true;
+  ++constraint_version_;
 }
 
 bool ClXpbdSolver::setPinTargets(const Vec3* targets, size_t count, std::string& error) {
@@ -251,22 +257,40 @@ void ClXpbdSolver::transform(const Mat3& R, const Vec3& pivot, const Vec3& t, fl
     for (size_t i = 0; i < particleCount(); ++i) v_[i].head<3>() = velocity_scale * (R * Vec3(v_[i].head<3>()));
   for (Vec3& p : pin_target_) p = R * (p - pivot) + shift;
   if (particleCount() == 0) return;
-  const cl_uint n = static_cast<cl_uint>(particleCount());
-  const DclF4 r0{R(0, 0), R(1, 0), R(2, 0), 0}, r1{R(0, 1), R(1, 1), R(2, 1), 0}, r2{R(0, 2), R(1, 2), R(2, 2), 0};
-  const DclF4 pv{pivot.x(), pivot.y(), pivot.z(), 0}, sv{shift.x(), shift.y(), shift.z(), 0};
+  // The device copy moves at the next device use (flushTransform), so that a batched frame can
+  // move every garment in one launch (ClFrameBatch); one transform waits at a time.
+  flushTransform();
+  DrapeClTransform& m = pending_transform_;
+  m.r0 = DclF4{R(0, 0), R(1, 0), R(2, 0), 0};
+  m.r1 = DclF4{R(0, 1), R(1, 1), R(2, 1), 0};
+  m.r2 = DclF4{R(0, 2), R(1, 2), R(2, 2), 0};
+  m.pivot = DclF4{pivot.x(), pivot.y(), pivot.z(), 0};
+  m.shift = DclF4{shift.x(), shift.y(), shift.z(), 0};
+  m.vscale = velocity_scale;
+  m.offset = 0;
+  m.count = static_cast<uint32_t>(particleCount());
+  transform_pending_ = true;
+}
+
+void ClXpbdSolver::flushTransform() {
+  if (!transform_pending_) return;
+  transform_pending_ = false;
+  const DrapeClTransform& m = pending_transform_;
+  const cl_uint n = m.count;
   cl_int rc = clSetKernelArg(transform_, 0, sizeof(cl_mem), &x_buf_);
   rc |= clSetKernelArg(transform_, 1, sizeof(cl_mem), &v_buf_);
   rc |= clSetKernelArg(transform_, 2, sizeof(cl_uint), &n);
-  rc |= clSetKernelArg(transform_, 3, 16, &r0);
-  rc |= clSetKernelArg(transform_, 4, 16, &r1);
-  rc |= clSetKernelArg(transform_, 5, 16, &r2);
-  rc |= clSetKernelArg(transform_, 6, 16, &pv);
-  rc |= clSetKernelArg(transform_, 7, 16, &sv);
-  rc |= clSetKernelArg(transform_, 8, sizeof(float), &velocity_scale);
+  rc |= clSetKernelArg(transform_, 3, 16, &m.r0);
+  rc |= clSetKernelArg(transform_, 4, 16, &m.r1);
+  rc |= clSetKernelArg(transform_, 5, 16, &m.r2);
+  rc |= clSetKernelArg(transform_, 6, 16, &m.pivot);
+  rc |= clSetKernelArg(transform_, 7, 16, &m.shift);
+  rc |= clSetKernelArg(transform_, 8, sizeof(float), &m.vscale);
   const size_t wg = 64, global = (particleCount() + wg - 1) / wg * wg;
-  if (rc == CL_SUCCESS)
+  if (rc == CL_SUCCESS) {
     rc = clEnqueueNDRangeKernel(runtime_->queue(), transform_, 1, nullptr, &global, &wg, 0, nullptr, nullptr);
     runtime_->countLaunches();
+  }
   if (rc != CL_SUCCESS) {
     // Keep host and device consistent: the host copy (already moved) goes to the device.
     device_error_ = std::string("transform kernel failed (") + clErrorName(rc) + ")";
@@ -322,6 +346,7 @@ bool ClXpbdSolver::setState(const Eigen::Vector4f* x, const Eigen::Vector4f* v, 
 
 const Eigen::Vector4f* ClXpbdSolver::velocities() const {
   if (v_stale_ && particleCount() > 0) {
+    const_cast<ClXpbdSolver*>(this)->flushTransform();  // the device copy is then the current one
     if (clEnqueueReadBuffer(runtime_->queue(), v_buf_, CL_TRUE, 0, particleCount() * 16, v_.data(), 0, nullptr,
                             nullptr) == CL_SUCCESS)
       v_stale_ = false;

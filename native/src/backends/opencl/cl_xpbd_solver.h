@@ -53,6 +53,13 @@ class ClXpbdSolver {
   // False (state unchanged) on bad arguments, or when the device fails (err() says why; the
   // state is then the last good one).
   bool step(float dt, int substeps = XpbdSolver::kDefaultSubsteps);
+  // step() in two halves, so that several garments' frames can run in one launch
+  // (ClFrameBatch): prepareFrame() is the host half (validation, this frame's shapes, pin
+  // targets and garment record; false on bad arguments, nothing prepared), runPreparedFrame()
+  // the device half for this garment alone. ClFrameBatch::run replaces the second for a batch.
+  bool prepareFrame(float dt, int substeps);
+  bool runPreparedFrame();
+  bool framePrepared() const { return prepared_; }
 
   size_t particleCount() const { return topology_.particleCount(); }
   const GarmentTopology& topology() const { return topology_; }
@@ -108,6 +115,18 @@ class ClXpbdSolver {
   float motion_margin_ = 0.0f;
   std::vector<DrapeClShape> shapes_;
   std::vector<DclF4> bounds_;
+
+  friend class ClFrameBatch;
+  DrapeClGarment frame_g_{};         // the prepared frame's record (offsets: this garment alone)
+  bool prepared_ = false;
+  uint64_t constraint_version_ = 0;  // bumped whenever constraints_ change (inv_w for a new h)
+  uint64_t batch_id_ = 0;            // unique per solver in the process (a batch's layout key)
+
+  // transform()'s device half, deferred to the next device use (or done for a whole batch by
+  // ClFrameBatch with drape_transform_batch): same arithmetic either way.
+  void flushTransform();
+  DrapeClTransform pending_transform_{};
+  bool transform_pending_ = false;
 
   bool enqueuePhases(const DrapeClGarment& g, std::vector<cl_event>& runs);
   Path path_ = Path::Auto;
