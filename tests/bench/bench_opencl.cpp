@@ -20,6 +20,8 @@
 #include "backends/opencl/cl_xpbd_solver.h"
 #endif
 
+#include "bench_garment_scene.h"
+
 #include <benchmark/benchmark.h>
 
 #include <map>
@@ -30,80 +32,15 @@
 namespace drape {
 namespace {
 
-std::string recordingPath() {
-  std::string dir = __FILE__;
-  dir = dir.substr(0, dir.find_last_of("/\\") + 1);
-  return dir + "../../samples/data/Ges01_wavehand.csv";
-}
-
-// Per recording frame: the ellipsoids and the pin targets (as bench_cloth.cpp's GarmentScene).
-struct Scene {
-  GarmentTopology topology;
-  std::vector<std::vector<Ellipsoid>> ellipsoids;
-  std::vector<std::vector<Vec3>> pins;
-  Mat3 rotation = Mat3::Identity();
-  Vec3 pivot = Vec3::Zero(), shift = Vec3::Zero();
-  std::string error;
-};
-
-std::unique_ptr<Scene> buildScene(int target_particles) {
-  auto out = std::make_unique<Scene>();
-  Recording rec;
-  if (!readRecordingFile(recordingPath(), 0, rec, out->error)) return out;
-  const ResolvedShape shape = resolveShape(BodyShapeInput{});
-  BodyModel body(shape, BodyModelParams{});
-  ProxyBuilder proxies(ProxyRule::Drape);
-  body.update(restPose(shape));
-  GarmentTemplateParams gp;
-  gp.kind = GarmentKind::TShirt;
-  gp.target_particles = target_particles;
-  GarmentMesh mesh;
-  if (!makeGarmentTemplate(body, gp, mesh, out->error)) return out;
-  const RingPose collar_rest = body.rings()[static_cast<size_t>(mesh.pin_ring[0])];
-  TopologyParams tp;
-  tp.pinned = mesh.pinned;
-  if (!buildGarmentTopology(mesh.positions.data()->data(), mesh.positions.size(), mesh.indices.data(),
-                            mesh.indices.size(), tp, out->topology, out->error))
-    return out;
-  std::map<uint32_t, size_t> pin_index;
-  for (size_t i = 0; i < mesh.pinned.size(); ++i) pin_index[mesh.pinned[i]] = i;
-  SkeletonTracker tracker;
-  for (const RecordingFrame& f : rec.frames) {
-    SkeletonPose raw;
-    if (!mapToCanonical(rec.layout, f.joints.data(), static_cast<int>(f.joints.size()), raw, out->error)) return out;
-    tracker.push(raw, f.time_s);
-    body.update(tracker.pose());
-    proxies.build(body, tracker.pose());
-    out->ellipsoids.push_back(proxies.ellipsoids());
-    std::vector<Vec3> pins;
-    for (uint32_t p : out->topology.pinned) {
-      const size_t i = pin_index[p];
-      const RingPose& r = body.rings()[static_cast<size_t>(mesh.pin_ring[i])];
-      pins.push_back(r.centre + r.frame * mesh.pin_local[i]);
-    }
-    out->pins.push_back(std::move(pins));
-    if (out->pins.size() == 1) {
-      const RingPose& c = body.rings()[static_cast<size_t>(mesh.pin_ring[0])];
-      out->rotation = c.frame * collar_rest.frame.transpose();
-      out->pivot = collar_rest.centre;
-      out->shift = c.centre - collar_rest.centre;
-    }
-  }
-  return out;
-}
+using Scene = bench::GarmentScene;
+using bench::pingPong;
 
 Scene& scene(int target, benchmark::State& state) {
   static std::map<int, std::unique_ptr<Scene>> cache;
   auto& s = cache[target];
-  if (!s) s = buildScene(target);
+  if (!s) s = bench::buildGarmentScene(target);
   if (!s->error.empty() || s->pins.empty()) state.SkipWithError(s->error.c_str());
   return *s;
-}
-
-size_t pingPong(size_t i, size_t n) {
-  if (n < 2) return 0;
-  const size_t period = 2 * (n - 1), k = i % period;
-  return k < n ? k : period - k;
 }
 
 constexpr int kSubsteps = 10;

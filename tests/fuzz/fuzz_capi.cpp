@@ -19,30 +19,10 @@ constexpr int kGarments = 6;
 constexpr int kMaxOps = 96;
 constexpr int kMaxSteps = 16;  // cloth steps per input (each up to ~10 substeps of 400 particles)
 
-// Kinect v2 standing pose; `t` animates a sway and an arm swing.
-void pose25(double t, drape_joint* j) {
-  static const float p[25][3] = {
-      {0.00f, 0.00f, 2.5f},    {0.00f, 0.30f, 2.5f},   {0.00f, 0.60f, 2.5f},   {0.00f, 0.75f, 2.48f},
-      {-0.18f, 0.50f, 2.5f},   {-0.24f, 0.24f, 2.5f},  {-0.27f, 0.01f, 2.48f}, {-0.28f, -0.06f, 2.47f},
-      {0.18f, 0.50f, 2.5f},    {0.24f, 0.24f, 2.5f},   {0.27f, 0.01f, 2.48f},  {0.28f, -0.06f, 2.47f},
-      {-0.08f, -0.02f, 2.5f},  {-0.09f, -0.45f, 2.52f}, {-0.09f, -0.85f, 2.55f}, {-0.09f, -0.92f, 2.45f},
-      {0.08f, -0.02f, 2.5f},   {0.09f, -0.45f, 2.52f}, {0.09f, -0.85f, 2.55f}, {0.09f, -0.92f, 2.45f},
-      {0.00f, 0.52f, 2.5f},    {-0.29f, -0.14f, 2.47f}, {-0.25f, -0.08f, 2.43f}, {0.29f, -0.14f, 2.47f},
-      {0.25f, -0.08f, 2.43f}};
-  const float sway = 0.03f * static_cast<float>(std::sin(1.3 * t));
-  const float swing = 0.08f * static_cast<float>(std::sin(2.1 * t));
-  for (int i = 0; i < 25; ++i) {
-    const bool left_arm = i == 5 || i == 6 || i == 7 || i == 21 || i == 22;
-    const bool right_arm = i == 9 || i == 10 || i == 11 || i == 23 || i == 24;
-    j[i].position = drape_vec3{p[i][0] + sway, p[i][1], p[i][2] + (left_arm ? swing : right_arm ? -swing : 0.0f)};
-    j[i].tracking_state = DRAPE_TRACKING_TRACKED;
-  }
-}
-
 // The same person in another layout: Kinect v1 (20) or Azure (32, extra points placed by hand).
 std::vector<drape_joint> poseFor(int32_t layout, double t) {
   drape_joint k[25];
-  pose25(t, k);
+  drape_fuzz::standingPose25(t, 0.08f, k);
   if (layout == DRAPE_LAYOUT_KINECT1) {
     std::vector<drape_joint> v(20);
     v[0] = k[0];

@@ -10,26 +10,9 @@ using namespace drape_fuzz;
 
 namespace {
 
-// A person standing 2.5 m from the sensor (Kinect v2 order), metres.
-void standingPose(double t, drape_joint* j) {
-  static const float p[25][3] = {
-      {0.00f, 0.00f, 2.5f},    {0.00f, 0.30f, 2.5f},   {0.00f, 0.60f, 2.5f},   {0.00f, 0.75f, 2.48f},
-      {-0.18f, 0.50f, 2.5f},   {-0.24f, 0.24f, 2.5f},  {-0.27f, 0.01f, 2.48f}, {-0.28f, -0.06f, 2.47f},
-      {0.18f, 0.50f, 2.5f},    {0.24f, 0.24f, 2.5f},   {0.27f, 0.01f, 2.48f},  {0.28f, -0.06f, 2.47f},
-      {-0.08f, -0.02f, 2.5f},  {-0.09f, -0.45f, 2.52f}, {-0.09f, -0.85f, 2.55f}, {-0.09f, -0.92f, 2.45f},
-      {0.08f, -0.02f, 2.5f},   {0.09f, -0.45f, 2.52f}, {0.09f, -0.85f, 2.55f}, {0.09f, -0.92f, 2.45f},
-      {0.00f, 0.52f, 2.5f},    {-0.29f, -0.14f, 2.47f}, {-0.25f, -0.08f, 2.43f}, {0.29f, -0.14f, 2.47f},
-      {0.25f, -0.08f, 2.43f}};
-  const float sway = 0.03f * static_cast<float>(std::sin(1.3 * t));
-  for (int i = 0; i < 25; ++i) {
-    j[i].position = drape_vec3{p[i][0] + sway, p[i][1], p[i][2]};
-    j[i].tracking_state = DRAPE_TRACKING_TRACKED;
-  }
-}
-
 drape_result pushFrame(drape_context* ctx, double t) {
   drape_joint j[25];
-  standingPose(t, j);
+  drape_fuzz::standingPose25(t, 0.0f, j);
   drape_skeleton_frame f;
   std::memset(&f, 0, sizeof f);
   f.struct_size = sizeof f;

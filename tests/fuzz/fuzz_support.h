@@ -108,4 +108,25 @@ class Bytes {
   size_t i_ = 0;
 };
 
+// A person standing 2.5 m from the sensor (Kinect v2 order, metres); `t` animates a sway and, with
+// arm_swing_m > 0, the arms swinging back and forth by that much (the C ABI and OBJ targets).
+inline void standingPose25(double t, float arm_swing_m, drape_joint* j) {
+  static const float p[25][3] = {
+      {0.00f, 0.00f, 2.5f},    {0.00f, 0.30f, 2.5f},   {0.00f, 0.60f, 2.5f},   {0.00f, 0.75f, 2.48f},
+      {-0.18f, 0.50f, 2.5f},   {-0.24f, 0.24f, 2.5f},  {-0.27f, 0.01f, 2.48f}, {-0.28f, -0.06f, 2.47f},
+      {0.18f, 0.50f, 2.5f},    {0.24f, 0.24f, 2.5f},   {0.27f, 0.01f, 2.48f},  {0.28f, -0.06f, 2.47f},
+      {-0.08f, -0.02f, 2.5f},  {-0.09f, -0.45f, 2.52f}, {-0.09f, -0.85f, 2.55f}, {-0.09f, -0.92f, 2.45f},
+      {0.08f, -0.02f, 2.5f},   {0.09f, -0.45f, 2.52f}, {0.09f, -0.85f, 2.55f}, {0.09f, -0.92f, 2.45f},
+      {0.00f, 0.52f, 2.5f},    {-0.29f, -0.14f, 2.47f}, {-0.25f, -0.08f, 2.43f}, {0.29f, -0.14f, 2.47f},
+      {0.25f, -0.08f, 2.43f}};
+  const float sway = 0.03f * static_cast<float>(std::sin(1.3 * t));
+  const float swing = arm_swing_m * static_cast<float>(std::sin(2.1 * t));
+  for (int i = 0; i < 25; ++i) {
+    const bool left_arm = i == 5 || i == 6 || i == 7 || i == 21 || i == 22;
+    const bool right_arm = i == 9 || i == 10 || i == 11 || i == 23 || i == 24;
+    j[i].position = drape_vec3{p[i][0] + sway, p[i][1], p[i][2] + (left_arm ? swing : right_arm ? -swing : 0.0f)};
+    j[i].tracking_state = DRAPE_TRACKING_TRACKED;
+  }
+}
+
 }  // namespace drape_fuzz

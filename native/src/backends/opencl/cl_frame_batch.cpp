@@ -69,10 +69,9 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
   pin_targets_.clear();
   shapes_host_.clear();
   bounds_host_.clear();
-  std::vector<std::pair<uint64_t, uint64_t>> layout;
-  layout.reserve(count);
+  std::vector<std::pair<uint64_t, uint64_t>>& layout = next_layout_;  // scratch, kept between frames
+  layout.clear();
   size_t particles = 0, pins = 0, constraints = 0, groups = 0;
-  std::vector<size_t> particle_offset(count);
   for (size_t i = 0; i < count; ++i) {
     const ClXpbdSolver& s = *solvers[i];
     DrapeClGarment g = s.frame_g_;
@@ -83,7 +82,6 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
     g.shape_offset = static_cast<uint32_t>(shapes_host_.size());
     g.span_offset = static_cast<uint32_t>(bounds_host_.size() / 2);
     table_[i] = g;
-    particle_offset[i] = particles;
     particles += s.particleCount();
     pins += s.pin_index_.size();
     constraints += s.constraints_.size();
@@ -136,9 +134,10 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
       for (uint32_t o : s->group_offsets_) groups_host_.push_back(base + o);
       constraints_host_.insert(constraints_host_.end(), s->constraints_.begin(), s->constraints_.end());
       pin_index_host_.insert(pin_index_host_.end(), s->pin_index_.begin(), s->pin_index_.end());
-      std::vector<uint8_t> m(s->masks_);
-      m.resize(s->particleCount(), 0xFF);  // as the solver's own buffer: every group when none given
-      masks_host_.insert(masks_host_.end(), m.begin(), m.end());
+      // As the solver's own buffer: every group for particles without a mask.
+      const size_t n = std::min(s->masks_.size(), s->particleCount());
+      masks_host_.insert(masks_host_.end(), s->masks_.begin(), s->masks_.begin() + static_cast<long>(n));
+      masks_host_.insert(masks_host_.end(), s->particleCount() - n, uint8_t{0xFF});
     }
     write(constraints_.mem, 0, constraints_host_.data(), constraints_host_.size() * sizeof(DrapeClConstraint));
     write(groups_.mem, 0, groups_host_.data(), groups_host_.size() * 4);
@@ -154,8 +153,8 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
   // pin_start are scratch the kernel writes before it reads them.
   for (size_t i = 0; i < count; ++i) {
     const size_t bytes = solvers[i]->particleCount() * 16;
-    copy(solvers[i]->x_buf_, 0, x_.mem, particle_offset[i] * 16, bytes);
-    copy(solvers[i]->v_buf_, 0, v_.mem, particle_offset[i] * 16, bytes);
+    copy(solvers[i]->x_buf_, 0, x_.mem, size_t{table_[i].particle_offset} * 16, bytes);
+    copy(solvers[i]->v_buf_, 0, v_.mem, size_t{table_[i].particle_offset} * 16, bytes);
   }
   // The deferred rigid carries (inertia scaling) of every member: one launch for all.
   transforms_host_.clear();
@@ -163,7 +162,7 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
     ClXpbdSolver& s = *solvers[i];
     if (!s.transform_pending_) continue;
     DrapeClTransform m = s.pending_transform_;
-    m.offset = static_cast<uint32_t>(particle_offset[i]);
+    m.offset = table_[i].particle_offset;
     transforms_host_.push_back(m);
     s.transform_pending_ = false;
   }
@@ -196,8 +195,8 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
   // solo frame use them), then one readback of every position and counter.
   for (size_t i = 0; i < count; ++i) {
     const size_t bytes = solvers[i]->particleCount() * 16;
-    copy(x_.mem, particle_offset[i] * 16, solvers[i]->x_buf_, 0, bytes);
-    copy(v_.mem, particle_offset[i] * 16, solvers[i]->v_buf_, 0, bytes);
+    copy(x_.mem, size_t{table_[i].particle_offset} * 16, solvers[i]->x_buf_, 0, bytes);
+    copy(v_.mem, size_t{table_[i].particle_offset} * 16, solvers[i]->v_buf_, 0, bytes);
   }
   stats_host_.resize(count);
   x_host_.resize(particles);
@@ -213,8 +212,8 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
   }
   for (size_t i = 0; i < count; ++i) {
     ClXpbdSolver& s = *solvers[i];
-    std::copy(x_host_.begin() + static_cast<long>(particle_offset[i]),
-              x_host_.begin() + static_cast<long>(particle_offset[i] + s.particleCount()), s.x_.begin());
+    std::copy(x_host_.begin() + static_cast<long>(size_t{table_[i].particle_offset}),
+              x_host_.begin() + static_cast<long>(size_t{table_[i].particle_offset} + s.particleCount()), s.x_.begin());
     s.v_stale_ = true;
     s.collision_stats_.tests = stats_host_[i].tests;
     s.collision_stats_.contacts = stats_host_[i].contacts;

@@ -47,6 +47,7 @@ class ClFrameBatch {
       masks_, shapes_, bounds_, stats_, transforms_;
   // The members (solver id, constraint version) whose static data the device holds.
   std::vector<std::pair<uint64_t, uint64_t>> layout_;
+  std::vector<std::pair<uint64_t, uint64_t>> next_layout_;  // run()'s scratch: this frame's members
   // Host staging of the last run (non-blocking uploads read them until the frame ends).
   std::vector<DrapeClGarment> table_;
   std::vector<DrapeClTransform> transforms_host_;  // the members' deferred rigid carries
