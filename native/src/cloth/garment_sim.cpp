@@ -27,6 +27,12 @@ constexpr float kDressStartScale = 0.6f;
 constexpr float kSkinBlendM = 0.015f;
 // A pelvis rotation beyond kPoseJumpRad + kMaxSpinRadPerS * dt in one step is no human motion.
 constexpr float kPoseJumpRad = 1.0f;          // 57 degrees
+// A pose jump that returns within kKeepBeforeJumpS, with every attachment target within
+// kRestoreBeforeJumpM (RMS, in the pelvis frame) of where it was, restores the garment as it was
+// before the jump (GarmentSim::restoreBeforeJump). A person moves their shoulders and waist
+// relative to the pelvis by a few centimetres in a few seconds when not bending over.
+constexpr double kKeepBeforeJumpS = 5.0;
+constexpr float kRestoreBeforeJumpM = 0.08f;
 constexpr float kMaxSpinRadPerS = 12.566f;    // two turns a second
 
 
@@ -369,6 +375,42 @@ void GarmentSim::placeOnBody(const BodyModel& body, const std::vector<Ellipsoid>
   last_.blend_frames = frames;
 }
 
+void GarmentSim::keepBeforeJump() {
+  // A snapshot younger than kKeepBeforeJumpS is the state before a flicker that has not ended
+  // yet (A -> B -> C -> A): keep it rather than the state on B.
+  if (before_jump_.valid && sim_time_s_ - before_jump_.time_s < kKeepBeforeJumpS) return;
+  const Mat3 to_local = seen_pelvis_f_.transpose();
+  const Eigen::Vector4f* x = solver_->x();
+  before_jump_.x.resize(particleCount());
+  for (size_t i = 0; i < before_jump_.x.size(); ++i) before_jump_.x[i] = to_local * (x[i].head<3>() - seen_pelvis_c_);
+  before_jump_.pins.resize(pins_.size());  // pins_ still holds the last step's targets
+  for (size_t k = 0; k < pins_.size(); ++k) before_jump_.pins[k] = to_local * (pins_[k] - seen_pelvis_c_);
+  before_jump_.time_s = sim_time_s_;
+  before_jump_.valid = true;
+}
+
+bool GarmentSim::restoreBeforeJump(const BodyModel& body, const RingPose& pelvis) {
+  if (!before_jump_.valid) return false;
+  if (sim_time_s_ - before_jump_.time_s >= kKeepBeforeJumpS ||
+      before_jump_.pins.size() != mesh_.pinned.size() || before_jump_.pins.empty()) {
+    before_jump_.valid = false;
+    return false;
+  }
+  pinTargets(body, pins_);
+  const Mat3 to_local = pelvis.frame.transpose();
+  float sum2 = 0.0f;
+  for (size_t k = 0; k < pins_.size(); ++k)
+    sum2 += (to_local * (pins_[k] - pelvis.centre) - before_jump_.pins[k]).squaredNorm();
+  if (!(sum2 <= kRestoreBeforeJumpM * kRestoreBeforeJumpM * static_cast<float>(pins_.size()))) return false;
+  scratch3_.resize(before_jump_.x.size());
+  for (size_t i = 0; i < scratch3_.size(); ++i) scratch3_[i] = pelvis.frame * before_jump_.x[i] + pelvis.centre;
+  std::string err;
+  if (!solver_->reset(scratch3_, err)) return false;
+  before_jump_.valid = false;
+  ++jump_restores_;
+  return true;
+}
+
 bool GarmentSim::poseJumped(const RingPose& pelvis, float dt) const {
   // The pelvis ring's rotation since the last step. People spin at up to ~2 turns a second (a
   // pirouette); kPoseJumpRad on top covers the tracker's own noise on a short frame.
@@ -418,6 +460,7 @@ void GarmentSim::stepBegin(const BodyModel& body, const std::vector<Ellipsoid>& 
   const std::vector<Ellipsoid>& end = pickReachable(end_all, reach_end_);
   pending_t0_ = Clock::now();
   last_ = GarmentStepStats{};
+  if (dt > 0.0f) sim_time_s_ += dt;
   pins_.resize(mesh_.pinned.size());
   const RingPose& pr = body.rings()[static_cast<size_t>(pelvis_ring_)];
   pending_body_ = &body;
@@ -426,7 +469,10 @@ void GarmentSim::stepBegin(const BodyModel& body, const std::vector<Ellipsoid>& 
     // First frame, or a pose no body reaches in dt from the last one (a skeleton flipped upside
     // down for a frame): the garment is put where the body's rings carry its dressed shape.
     last_.teleport_reset = tracked_;
-    placeOnBody(body, end);
+    if (!tracked_ || !restoreBeforeJump(body, pr)) {
+      if (tracked_) keepBeforeJump();
+      placeOnBody(body, end);
+    }
     tracked_ = true;
     runStepFrame(end, end, pins_, dt);
   } else if (teleported) {

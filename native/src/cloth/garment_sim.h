@@ -152,6 +152,8 @@ class GarmentSim {
   void markSkipped() { last_ = GarmentStepStats{}; }
 
   const GarmentStepStats& lastStep() const { return last_; }
+  // Pose jumps that came back and found the garment's state from before the jump (keepBeforeJump).
+  uint32_t poseJumpRestores() const { return jump_restores_; }
   uint64_t steps() const { return steps_; }
 
   // Accuracy now against `ellipsoids` and, when `body_bvh` is non-null, the body mesh it holds.
@@ -198,6 +200,20 @@ class GarmentSim {
   void carry(const Mat3& R, const Vec3& pivot, const Vec3& t, float velocity_scale);
   // Places the dressed garment on `body` by skinning and settles it for blend_in_s.
   void placeOnBody(const BodyModel& body, const std::vector<Ellipsoid>& ellipsoids);
+  // Pose jumps that come back. A Kinect skeleton that flips (or is swapped with another person's)
+  // for a moment and then returns would otherwise cost two re-placements, and the second leaves
+  // the garment in the stretched skinned shape until friction lets it slide back. At the first
+  // jump the garment's last state is kept relative to the pelvis (with its attachment targets);
+  // a later jump that lands where the attachments were restores it.
+  void keepBeforeJump();
+  bool restoreBeforeJump(const BodyModel& body, const RingPose& pelvis);
+  struct BeforeJump {
+    std::vector<Vec3> x, pins;  // positions and attachment targets in the pelvis ring's frame
+    double time_s = 0.0;        // sim_time_s_ when it was kept
+    bool valid = false;
+  } before_jump_;
+  double sim_time_s_ = 0.0;     // the dt of every step so far
+  uint32_t jump_restores_ = 0;
 
   GarmentMesh mesh_;
   GarmentTopology topology_;
