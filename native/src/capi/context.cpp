@@ -380,6 +380,7 @@ drape_result Context::beginStep(float dt, std::string& err) {
       continue;
     }
     const std::vector<Ellipsoid>* woke = adaptive_.wakeStart(g.get(), now);
+    g->setTrackingNoise(tracker_.noiseSigmaM());  // noise bursts: garment_recovery.cpp
     // Device frames are only staged here: the caller runs them all together (runStagedFrames).
     g->stepBegin(*body_, woke ? *woke : stepEllipsoids_, now, dt, teleportPending_, true);
     stepping_.push_back(g.get());

@@ -27,12 +27,6 @@ constexpr float kDressStartScale = 0.6f;
 constexpr float kSkinBlendM = 0.015f;
 // A pelvis rotation beyond kPoseJumpRad + kMaxSpinRadPerS * dt in one step is no human motion.
 constexpr float kPoseJumpRad = 1.0f;          // 57 degrees
-// A pose jump that returns within kKeepBeforeJumpS, with every attachment target within
-// kRestoreBeforeJumpM (RMS, in the pelvis frame) of where it was, restores the garment as it was
-// before the jump (GarmentSim::restoreBeforeJump). A person moves their shoulders and waist
-// relative to the pelvis by a few centimetres in a few seconds when not bending over.
-constexpr double kKeepBeforeJumpS = 5.0;
-constexpr float kRestoreBeforeJumpM = 0.08f;
 constexpr float kMaxSpinRadPerS = 12.566f;    // two turns a second
 
 
@@ -375,42 +369,6 @@ void GarmentSim::placeOnBody(const BodyModel& body, const std::vector<Ellipsoid>
   last_.blend_frames = frames;
 }
 
-void GarmentSim::keepBeforeJump() {
-  // A snapshot younger than kKeepBeforeJumpS is the state before a flicker that has not ended
-  // yet (A -> B -> C -> A): keep it rather than the state on B.
-  if (before_jump_.valid && sim_time_s_ - before_jump_.time_s < kKeepBeforeJumpS) return;
-  const Mat3 to_local = seen_pelvis_f_.transpose();
-  const Eigen::Vector4f* x = solver_->x();
-  before_jump_.x.resize(particleCount());
-  for (size_t i = 0; i < before_jump_.x.size(); ++i) before_jump_.x[i] = to_local * (x[i].head<3>() - seen_pelvis_c_);
-  before_jump_.pins.resize(pins_.size());  // pins_ still holds the last step's targets
-  for (size_t k = 0; k < pins_.size(); ++k) before_jump_.pins[k] = to_local * (pins_[k] - seen_pelvis_c_);
-  before_jump_.time_s = sim_time_s_;
-  before_jump_.valid = true;
-}
-
-bool GarmentSim::restoreBeforeJump(const BodyModel& body, const RingPose& pelvis) {
-  if (!before_jump_.valid) return false;
-  if (sim_time_s_ - before_jump_.time_s >= kKeepBeforeJumpS ||
-      before_jump_.pins.size() != mesh_.pinned.size() || before_jump_.pins.empty()) {
-    before_jump_.valid = false;
-    return false;
-  }
-  pinTargets(body, pins_);
-  const Mat3 to_local = pelvis.frame.transpose();
-  float sum2 = 0.0f;
-  for (size_t k = 0; k < pins_.size(); ++k)
-    sum2 += (to_local * (pins_[k] - pelvis.centre) - before_jump_.pins[k]).squaredNorm();
-  if (!(sum2 <= kRestoreBeforeJumpM * kRestoreBeforeJumpM * static_cast<float>(pins_.size()))) return false;
-  scratch3_.resize(before_jump_.x.size());
-  for (size_t i = 0; i < scratch3_.size(); ++i) scratch3_[i] = pelvis.frame * before_jump_.x[i] + pelvis.centre;
-  std::string err;
-  if (!solver_->reset(scratch3_, err)) return false;
-  before_jump_.valid = false;
-  ++jump_restores_;
-  return true;
-}
-
 bool GarmentSim::poseJumped(const RingPose& pelvis, float dt) const {
   // The pelvis ring's rotation since the last step. People spin at up to ~2 turns a second (a
   // pirouette); kPoseJumpRad on top covers the tracker's own noise on a short frame.
@@ -465,13 +423,16 @@ void GarmentSim::stepBegin(const BodyModel& body, const std::vector<Ellipsoid>& 
   const RingPose& pr = body.rings()[static_cast<size_t>(pelvis_ring_)];
   pending_body_ = &body;
   pending_end_ = &end;
+  const bool burst_ended = tracked_ && noiseBurstEnded();
   if (!tracked_ || poseJumped(pr, dt)) {
     // First frame, or a pose no body reaches in dt from the last one (a skeleton flipped upside
     // down for a frame): the garment is put where the body's rings carry its dressed shape.
     last_.teleport_reset = tracked_;
-    if (!tracked_ || !restoreBeforeJump(body, pr)) {
-      if (tracked_) keepBeforeJump();
+    if (!tracked_ || !restoreState(before_jump_, body, pr, end)) {
+      if (tracked_) keepBeforeJump(start);
       placeOnBody(body, end);
+    } else {
+      ++jump_restores_;
     }
     tracked_ = true;
     runStepFrame(end, end, pins_, dt);
@@ -480,6 +441,10 @@ void GarmentSim::stepBegin(const BodyModel& body, const std::vector<Ellipsoid>& 
     last_.teleport_reset = true;
     carry(pr.frame * seen_pelvis_f_.transpose(), seen_pelvis_c_, pr.centre - seen_pelvis_c_, 0.0f);
     pinTargets(body, pins_);
+    runStepFrame(end, end, pins_, dt);
+  } else if (burst_ended && restoreState(before_burst_, body, pr, end)) {
+    // A burst of sensor noise ended: the garment as it was before it, swept to this pose.
+    ++burst_restores_;
     runStepFrame(end, end, pins_, dt);
   } else {
     // Inertia scaling: the part of the pelvis' rigid motion the garment does not feel moves it.
@@ -527,6 +492,7 @@ void GarmentSim::stepEnd() {
   }
   seen_pelvis_c_ = pr.centre;
   seen_pelvis_f_ = pr.frame;
+  keepCalmState(pr);
   ++steps_;
   last_.total_ms = msSince(pending_t0_);
 }

@@ -152,8 +152,12 @@ class GarmentSim {
   void markSkipped() { last_ = GarmentStepStats{}; }
 
   const GarmentStepStats& lastStep() const { return last_; }
-  // Pose jumps that came back and found the garment's state from before the jump (keepBeforeJump).
+  // Pose jumps that came back and found the garment's state from before the jump (restored).
   uint32_t poseJumpRestores() const { return jump_restores_; }
+  // Noise bursts that ended with the garment restored to its state before the burst.
+  uint32_t noiseBurstRestores() const { return burst_restores_; }
+  // The tracker's sensor-noise estimate (SkeletonTracker::noiseSigmaM), given before each step.
+  void setTrackingNoise(float sigma_m) { tracking_noise_m_ = sigma_m >= 0.0f ? sigma_m : 0.0f; }
   uint64_t steps() const { return steps_; }
 
   // Accuracy now against `ellipsoids` and, when `body_bvh` is non-null, the body mesh it holds.
@@ -200,20 +204,39 @@ class GarmentSim {
   void carry(const Mat3& R, const Vec3& pivot, const Vec3& t, float velocity_scale);
   // Places the dressed garment on `body` by skinning and settles it for blend_in_s.
   void placeOnBody(const BodyModel& body, const std::vector<Ellipsoid>& ellipsoids);
-  // Pose jumps that come back. A Kinect skeleton that flips (or is swapped with another person's)
-  // for a moment and then returns would otherwise cost two re-placements, and the second leaves
-  // the garment in the stretched skinned shape until friction lets it slide back. At the first
-  // jump the garment's last state is kept relative to the pelvis (with its attachment targets);
-  // a later jump that lands where the attachments were restores it.
-  void keepBeforeJump();
-  bool restoreBeforeJump(const BodyModel& body, const RingPose& pelvis);
-  struct BeforeJump {
-    std::vector<Vec3> x, pins;  // positions and attachment targets in the pelvis ring's frame
-    double time_s = 0.0;        // sim_time_s_ when it was kept
+  // Recovery from tracking glitches (garment_recovery.cpp, docs/robustness.md). A skeleton that
+  // flips (or is swapped with another person's) for a moment, or a burst of sensor noise, leaves
+  // the garment tangled or stretched well after the glitch ends: friction lets cloth caught on the
+  // wrong side of a limb slide back only slowly. So the garment's state from before the glitch is
+  // kept relative to the pelvis ring (with its attachment targets and ellipsoids), and when the
+  // glitch ends with the attachments back within kRestoreMatchM of where they were, that state is
+  // restored and swept to the current pose by kCatchUpFrames frames of simulation.
+  struct KeptState {
+    std::vector<Vec3> x, pins;          // positions and attachment targets, pelvis ring frame
+    std::vector<Ellipsoid> ellipsoids;  // the garment's ellipsoids then, pelvis ring frame
+    double time_s = 0.0;                // sim_time_s_ when kept
     bool valid = false;
-  } before_jump_;
-  double sim_time_s_ = 0.0;     // the dt of every step so far
-  uint32_t jump_restores_ = 0;
+  };
+  void keepState(KeptState& k, const std::vector<Ellipsoid>& ellipsoids, const RingPose& pelvis,
+                 const std::vector<Vec3>& pins) const;
+  bool restoreState(KeptState& k, const BodyModel& body, const RingPose& pelvis,
+                    const std::vector<Ellipsoid>& end);
+  // At a pose jump: keeps the state the garment had on the last pose (unless a younger kept
+  // state from an earlier jump of the same glitch exists, A -> B -> C -> A).
+  void keepBeforeJump(const std::vector<Ellipsoid>& start);
+  // Follows the tracker's noise estimate; true on the step a noise burst ends.
+  bool noiseBurstEnded();
+  void keepCalmState(const RingPose& pelvis);  // stepEnd: a snapshot every kCalmEveryS while calm
+  KeptState before_jump_, before_burst_;
+  KeptState calm_[3];
+  int calm_next_ = 0;
+  double calm_last_s_ = -1e9;
+  bool in_burst_ = false;
+  float tracking_noise_m_ = 0.0f;
+  double sim_time_s_ = 0.0;  // the dt of every step so far
+  uint32_t jump_restores_ = 0, burst_restores_ = 0;
+  std::vector<Ellipsoid> catch_a_, catch_b_;  // restoreState scratch
+  std::vector<Vec3> catch_pins_;
 
   GarmentMesh mesh_;
   GarmentTopology topology_;
