@@ -67,7 +67,8 @@ void runFrames(S& s, Scene& sc, size_t& frame, int count, bool collide, Motion&&
 }
 
 // Args: backend (0 CPU, 1 OpenCL), target particles, collide (0/1), path (OpenCL: 0 = automatic
-// choice, ClXpbdSolver::Path::Auto; 1 = the one-work-group frame forced).
+// choice, ClXpbdSolver::Path::Auto; 1 = the one-work-group frame forced; 2 = the per-phase
+// launches forced, to price the 4 096-particle threshold on a GPU).
 void BM_BackendGarmentFrame(benchmark::State& state) {
   const bool opencl = state.range(0) == 1;
   const bool collide = state.range(2) == 1;
@@ -105,6 +106,7 @@ void BM_BackendGarmentFrame(benchmark::State& state) {
     auto s = ClXpbdSolver::create(rt, sc.topology, {}, {}, error);
     if (!s) return state.SkipWithError(error.c_str());
     if (state.range(3) == 1) s->setPath(ClXpbdSolver::Path::WorkGroup);
+    if (state.range(3) == 2) s->setPath(ClXpbdSolver::Path::Phases);
     s->setParams(benchParams(), error);
     s->transform(sc.rotation, sc.pivot, sc.shift, 0.0f);
     auto motion = [&](const std::vector<Ellipsoid>& e0, const std::vector<Ellipsoid>& e1) {
@@ -140,9 +142,10 @@ void backendArgs(benchmark::internal::Benchmark* b) {
     for (int collide : {1, 0}) {
       for (int backend : {0, 1}) b->Args({backend, particles, collide, 0});
       if (particles >= 8000 && particles <= 32000) b->Args({1, particles, collide, 1});  // work-group forced
+      if (particles == 2000) b->Args({1, particles, collide, 2});  // per-phase launches forced
     }
 }
-BENCHMARK(BM_BackendGarmentFrame)->Apply(backendArgs)->ArgNames({"opencl", "particles", "collide", "workgroup"})
+BENCHMARK(BM_BackendGarmentFrame)->Apply(backendArgs)->ArgNames({"opencl", "particles", "collide", "path"})
     ->Unit(benchmark::kMillisecond)->MinTime(0.5);
 
 }  // namespace
