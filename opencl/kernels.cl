@@ -1,5 +1,6 @@
 /* Entry points. The host assembles the program as: drape_cl_types.h, closest_point.cl,
- * collide.cl, xpbd_frame.cl twice (local / global particles), this file; with -D
+ * collide.cl, xpbd_frame.cl twice (local / global particles), this file, phases.cl (the
+ * per-phase kernels of large garments); with -D
  * DRAPE_CL_MAX_LOCAL_PARTICLES (the __local capacity the host sized) and
  * DRAPE_CL_WORK_GROUP (the work-group size the kernels are launched with). */
 
@@ -96,11 +97,13 @@ __kernel void drape_project_group(__global float4* x, __global const DrapeClCons
 
 /* Area-weighted unit vertex normals (vertexNormals in body/mesh_metrics.cpp) without atomics:
  * vertex i sums the face normals of the triangles listed in vertex_faces[face_offsets[i] ..
- * face_offsets[i + 1]) (ascending, as the CPU's accumulation order). */
+ * face_offsets[i + 1]) (ascending, as the CPU's accumulation order), into normals[out_offset +
+ * i]. The frame passes its particle buffer as both x and normals (positions in [0, count),
+ * normals in [count, 2 count): disjoint), so one readback brings both back. */
 __kernel void drape_vertex_normals(__global const float4* x, __global const uint* indices,
                                    __global const uint* face_offsets,
                                    __global const uint* vertex_faces, uint count,
-                                   __global float4* normals) {
+                                   __global float4* normals, uint out_offset) {
   const uint i = get_global_id(0);
   if (i >= count) return;
   float3 n = (float3)(0.0f);
@@ -111,7 +114,8 @@ __kernel void drape_vertex_normals(__global const float4* x, __global const uint
     n += cross(b - a, c - a);
   }
   const float len = length(n);
-  normals[i] = len > 1e-20f ? (float4)(n / len, 0.0f) : (float4)(0.0f, 1.0f, 0.0f, 0.0f);
+  normals[out_offset + i] =
+      len > 1e-20f ? (float4)(n / len, 0.0f) : (float4)(0.0f, 1.0f, 0.0f, 0.0f);
 }
 
 /* XpbdSolver::transform on the device state: x -> R (x - pivot) + shift, v -> vscale R v
@@ -142,99 +146,4 @@ __kernel void drape_transform_batch(__global float4* x, __global float4* v,
     const float3 u = v[i].xyz;
     v[i] = (float4)(vscale * (r0.xyz * u.x + r1.xyz * u.y + r2.xyz * u.z), 0.0f);
   }
-}
-
-/* ---- Large garments: the same frame as drape_xpbd_frame, one launch per phase over global
- * memory with one work-item per particle (or constraint), so every compute unit takes part.
- * Per substep: drape_phase_predict, drape_phase_pins, one drape_project_group per colour group
- * (distance, then tethers; `iterations` times), drape_phase_collide_velocity. The host passes
- * the substep index; the arithmetic per particle is the frame kernel's, in the same order. */
-
-__kernel void drape_phase_predict(__global const DrapeClGarment* g, __global float4* x,
-                                  __global float4* prev, __global float4* vel,
-                                  __global float4* span_start, int keep_span_start) {
-  const uint i = get_global_id(0);
-  if (i >= g->particle_count) return;
-  const float4 xi = x[i];
-  if (keep_span_start) span_start[i] = xi;
-  prev[i] = xi;
-  if (xi.w == 0.0f) return;
-  float4 v = vel[i];
-  v += g->hg + g->h_drag * (g->wind - v);
-  if (g->max_speed2 > 0.0f) {
-    const float s2 = dot(v, v);
-    if (s2 > g->max_speed2) v *= g->max_speed / sqrt(s2);
-  }
-  vel[i] = v;
-  x[i] = xi + g->h * v;
-}
-
-/* Pinned particles at substep `substep` (pin_start taken by drape_phase_pin_start). */
-__kernel void drape_phase_pins(__global const DrapeClGarment* g, __global float4* x,
-                               __global float4* pin_start, __global const uint* pin_index,
-                               __global const float4* pin_target, int substep) {
-  const uint k = get_global_id(0);
-  if (k >= g->pin_count) return;
-  const float pin_t = substep + 1 == g->substeps ? 1.0f : (float)(substep + 1) * g->inv_n;
-  const float4 a = pin_start[k];
-  const float4 b = pin_target[k];
-  const uint p = pin_index[k];
-  x[p] = (float4)(a.xyz + pin_t * (b.xyz - a.xyz), x[p].w);
-}
-
-__kernel void drape_phase_pin_start(__global const DrapeClGarment* g, __global const float4* x,
-                                    __global float4* pin_start, __global const uint* pin_index) {
-  const uint k = get_global_id(0);
-  if (k < g->pin_count) pin_start[k] = x[pin_index[k]];
-}
-
-/* Collision against span `span` (when collide != 0), then the velocity update. Counters: one
- * atomic per work-item that found something. */
-__kernel void drape_phase_collide_velocity(__global const DrapeClGarment* g, __global float4* x,
-                                           __global const float4* prev, __global float4* vel,
-                                           __global const float4* span_start,
-                                           __global const uchar* masks,
-                                           __global const DrapeClShape* shapes,
-                                           __global const float4* span_bounds,
-                                           __global DrapeClStats* stats, int collide, int span) {
-  const uint i = get_global_id(0);
-  if (i >= g->particle_count) return;
-  float4 xi = x[i];
-  const float4 pi = prev[i];
-  CollideCounters st = {0u, 0u, 0u, 0u};
-  if (collide && g->shape_count > 0u) {
-    CollideSpan sp;
-    sp.shapes = shapes + g->shape_offset + (uint)span * g->shape_count;
-    sp.count = g->shape_count;
-    sp.flags = g->flags;
-    sp.bound_min = span_bounds[2 * (g->span_offset + (uint)span)].xyz;
-    sp.bound_max = span_bounds[2 * (g->span_offset + (uint)span) + 1].xyz;
-    sp.static_friction = g->static_friction;
-    sp.kinetic_friction = g->kinetic_friction;
-    sp.max_escape = g->max_escape;
-    const float4 from = g->stride > 1 ? span_start[i] : pi;
-    const uint mask = (g->flags & DRAPE_CL_GROUPED) ? (uint)masks[g->particle_offset + i] : 0xFFu;
-    const float4 y = collide_particle(&sp, mask, xi, from, &st);
-    if (any(y.xyz != xi.xyz)) {
-      xi = y;
-      x[i] = xi;
-    }
-  }
-  float4 v = (xi - pi) * g->velocity_scale;
-  if (g->max_speed2 > 0.0f) {
-    const float s2 = dot(v, v);
-    if (s2 > g->max_speed2) v *= g->max_speed / sqrt(s2);
-  }
-  vel[i] = v;
-  if (st.tests) atomic_add(&stats->tests, st.tests);
-  if (st.contacts) atomic_add(&stats->contacts, st.contacts);
-  if (st.swept_catches) atomic_add(&stats->swept_catches, st.swept_catches);
-  if (st.escapes) atomic_add(&stats->escapes, st.escapes);
-}
-
-__kernel void drape_phase_clear_stats(__global DrapeClStats* stats) {
-  stats->tests = 0u;
-  stats->contacts = 0u;
-  stats->swept_catches = 0u;
-  stats->escapes = 0u;
 }

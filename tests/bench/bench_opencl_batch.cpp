@@ -6,6 +6,10 @@
 // (batching off) and the contexts one drape_context_step each. Per iteration: one 1/30 s frame
 // of every context. Counters: launches per frame (every kernel launch, the per-garment
 // drape_transform of the inertia carry included), garments.
+// particles: the T-shirts' size (5 000: over the one-work-group limit, the per-phase path, whose
+// phases batch too). normals = 1: every garment's vertex normals read each frame
+// (drape_garment_read_mesh: on OpenCL computed on the device with the frame, on the CPU by
+// vertexNormals). opencl = 0: the same on the CPU backend (the normals' CPU cost).
 // Run: ./build/batch/tests/drape_benchmarks --benchmark_filter=Batch --benchmark_repetitions=3
 //      --benchmark_report_aggregates_only=true
 #include "drape/drape.h"
@@ -51,10 +55,14 @@ bool loadTake(Take& take) {
   return ok && !take.joints.empty();
 }
 
-// args: contexts, garments per context, batched.
+// args: contexts, garments per context, batched, particles, normals, opencl.
 void BM_BatchFrames(benchmark::State& state) {
   const int contexts = static_cast<int>(state.range(0)), garments = static_cast<int>(state.range(1));
   const bool batched = state.range(2) != 0;
+  const uint32_t particles = static_cast<uint32_t>(state.range(3));
+  const bool normals = state.range(4) != 0, opencl = state.range(5) != 0;
+  std::vector<drape_garment*> all;
+  std::vector<drape_vec3> scratch;
   Take take;
   if (!loadTake(take)) {
     state.SkipWithError("the bundled Kinect take did not load");
@@ -67,17 +75,18 @@ void BM_BatchFrames(benchmark::State& state) {
     for (int g = 0; ok && g < garments; ++g) {
       drape_garment_template t;
       drape_garment_template_init(&t);
-      t.particles = 1000;
+      t.particles = particles;
       drape_garment* out = nullptr;
       ok = drape_context_add_garment_template(c, nullptr, &t, nullptr, &out) == DRAPE_OK;
+      all.push_back(out);
     }
     drape_backend_desc b;
     drape_backend_desc_init(&b);
-    b.backend = DRAPE_BACKEND_OPENCL;
+    b.backend = opencl ? DRAPE_BACKEND_OPENCL : DRAPE_BACKEND_CPU;
     drape_backend_info info;
     info.struct_size = sizeof(info);
     ok = ok && drape_context_set_backend(c, &b) == DRAPE_OK && drape_context_get_backend_info(c, &info) == DRAPE_OK &&
-         info.active == DRAPE_BACKEND_OPENCL;
+         info.active == b.backend;
   }
   drape::setClFrameBatching(batched);
   size_t frame = 0;
@@ -97,6 +106,13 @@ void BM_BatchFrames(benchmark::State& state) {
       ok = ok && drape_step_contexts(ctx.data(), static_cast<uint32_t>(ctx.size()), 1.0f / 30.0f) == DRAPE_OK;
     } else {
       for (drape_context* c : ctx) ok = ok && drape_context_step(c, 1.0f / 30.0f) == DRAPE_OK;
+    }
+    for (drape_garment* g : all) {
+      if (!normals || !ok) break;
+      uint32_t n = 0;
+      ok = drape_garment_get_mesh_size(g, &n, nullptr) == DRAPE_OK;
+      scratch.resize(n);
+      ok = ok && drape_garment_read_mesh(g, nullptr, scratch.data(), n, nullptr, 0) == DRAPE_OK;
     }
   };
   for (int w = 0; w < 10 && ok; ++w) step();  // dressing, placing, the first frames
@@ -118,12 +134,26 @@ void BM_BatchFrames(benchmark::State& state) {
 }
 
 BENCHMARK(BM_BatchFrames)
-    ->Args({1, 1, 1})
-    ->Args({1, 4, 0})
-    ->Args({1, 4, 1})
-    ->Args({4, 1, 0})
-    ->Args({4, 1, 1})
-    ->ArgNames({"contexts", "garments", "batched"})
+    ->Args({1, 1, 1, 1000, 0, 1})
+    ->Args({1, 4, 0, 1000, 0, 1})
+    ->Args({1, 4, 1, 1000, 0, 1})
+    ->Args({4, 1, 0, 1000, 0, 1})
+    ->Args({4, 1, 1, 1000, 0, 1})
+    // Large garments (per-phase path): one by one vs batched, one context and two.
+    ->Args({1, 1, 1, 5000, 0, 1})
+    ->Args({1, 2, 0, 5000, 0, 1})
+    ->Args({1, 2, 1, 5000, 0, 1})
+    ->Args({2, 1, 0, 5000, 0, 1})
+    ->Args({2, 1, 1, 5000, 0, 1})
+    // Normals read every frame: on the device (opencl 1) or by the CPU (opencl 0), vs not read.
+    ->Args({1, 1, 1, 1000, 1, 1})
+    ->Args({1, 1, 1, 1000, 0, 0})
+    ->Args({1, 1, 1, 1000, 1, 0})
+    ->Args({1, 4, 1, 1000, 1, 1})
+    ->Args({1, 1, 1, 5000, 1, 1})
+    ->Args({1, 1, 1, 5000, 0, 0})
+    ->Args({1, 1, 1, 5000, 1, 0})
+    ->ArgNames({"contexts", "garments", "batched", "particles", "normals", "opencl"})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(60);
 #endif

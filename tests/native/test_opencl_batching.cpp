@@ -262,6 +262,70 @@ TEST(OpenClBatching, MixedCpuAndDeviceGarmentsUnderAuto) {
   const size_t n0 = cpu_run.back().size();
   EXPECT_TRUE(std::memcmp(cpu_run.back().data(), together.back().data(), n0 * sizeof(float)) == 0);
 }
+
+// Large garments (over 4 096 particles: the per-phase path) batch too, each phase launched once
+// for all of them. 5 000-particle T-shirts: the template makes them larger than the one
+// work-group limit, which the test checks, so they really take the per-phase path.
+constexpr uint32_t kLarge = 5000;
+
+void expectLarge(const World& w, size_t garment) {
+  const float* x = nullptr;
+  uint32_t n = 0;
+  ASSERT_EQ(drape_garment_view_positions(w.garments[garment], &x, &n), DRAPE_OK) << lastError();
+  EXPECT_GT(n, 4096u) << "not on the per-phase path";
+}
+
+// Two large garments and a small one in one context: bit for bit as one by one (one frame launch
+// for the small one, each phase once for both large ones). Two contexts (large; small) through
+// drape_step_contexts: as stepping each (each alone there).
+TEST(OpenClBatching, LargeGarmentsMatchOneByOneBitForBit) {
+  DRAPE_LOAD_TAKE(take, 4);
+  const std::vector<uint32_t> sizes = {kLarge, 600, kLarge};
+  World one = makeWorld(sizes, DRAPE_BACKEND_OPENCL);
+  DRAPE_REQUIRE_DEVICE_WORLD(one);
+  expectLarge(one, 0);
+  expectLarge(one, 2);
+  std::vector<std::vector<float>> by_one;
+  {
+    Batching off(false);
+    by_one = runTake({&one}, take, false);
+  }
+  World batched = makeWorld(sizes, DRAPE_BACKEND_OPENCL);
+  expectSameRuns(runTake({&batched}, take, false), by_one);
+  World a = makeWorld({kLarge}, DRAPE_BACKEND_OPENCL), b = makeWorld({600}, DRAPE_BACKEND_OPENCL);
+  const auto separate = runTake({&a, &b}, take, false);
+  World c = makeWorld({kLarge}, DRAPE_BACKEND_OPENCL), d = makeWorld({600}, DRAPE_BACKEND_OPENCL);
+  expectSameRuns(runTake({&c, &d}, take, true), separate);
+}
+
+// Launches per frame on the per-phase path (~25 per substep) do not grow with the number of large
+// garments: 1 or 2 large garments batched cost the launches of one alone; a small one adds its
+// batch's frame launch; one by one, each large garment pays its own.
+TEST(OpenClBatching, LargeGarmentLaunchesDoNotGrowWithTheirNumber) {
+  DRAPE_LOAD_TAKE(take, 6);
+  // Frames [first, first + 3): the launches of the last (the first frame places the garments).
+  auto launchesPerFrame = [&](World& w, bool batching, size_t first = 0) {
+    Batching scope(batching);
+    uint64_t per_frame = 0;
+    for (size_t f = first; f < first + 3; ++f) {
+      EXPECT_EQ(push(w, take, f), DRAPE_OK) << lastError();
+      const uint64_t before = drape::ClRuntime::processLaunchCount();
+      EXPECT_EQ(drape_context_step(w.ctx.get(), kDt), DRAPE_OK) << lastError();
+      per_frame = drape::ClRuntime::processLaunchCount() - before;
+    }
+    return per_frame;
+  };
+  World one = makeWorld({kLarge}, DRAPE_BACKEND_OPENCL, 0, 1.0f);
+  DRAPE_REQUIRE_DEVICE_WORLD(one);
+  expectLarge(one, 0);
+  const uint64_t alone = launchesPerFrame(one, true);
+  EXPECT_GT(alone, 10u * 20u);  // 10 substeps of ~25 phase launches: the per-phase path
+  World two = makeWorld({kLarge, kLarge}, DRAPE_BACKEND_OPENCL, 0, 1.0f);
+  EXPECT_EQ(launchesPerFrame(two, true), alone);
+  EXPECT_EQ(launchesPerFrame(two, false, 3), 2 * alone);  // the same garments, one by one
+  World mixed = makeWorld({600, kLarge}, DRAPE_BACKEND_OPENCL, 0, 1.0f);
+  EXPECT_EQ(launchesPerFrame(mixed, true), alone + 1);
+}
 #endif  // DRAPE_HAVE_OPENCL
 
 // drape_step_contexts' checks (no device needed): each rejected call changes nothing.

@@ -670,7 +670,8 @@ namespace Drape
         public uint Reserved2;
         /// <summary>step_ms: wall time of the garment's last step.</summary>
         public double StepMs;
-        /// <summary>collide_ms: of which ellipsoid collision.</summary>
+        /// <summary>collide_ms: of which ellipsoid collision; 0 on the OpenCL backend, where collision
+        /// runs inside the device frame (integrate_ms then holds the whole frame).</summary>
         public double CollideMs;
         /// <summary>integrate_ms: the rest (integration and constraints).</summary>
         public double IntegrateMs;

@@ -567,8 +567,10 @@ typedef struct drape_garment_stats {
   uint8_t reserved0, reserved1;
   uint32_t reserved2;
   double step_ms;           /* wall time of the garment's last step */
-  double collide_ms;        /* of which ellipsoid collision */
-  double integrate_ms;      /* the rest: integration and constraints */
+  double collide_ms;        /* of which ellipsoid collision; 0 on the OpenCL backend, where
+                               collision runs inside the device frame (docs/opencl.md) */
+  double integrate_ms;      /* the rest: integration and constraints; on OpenCL the whole
+                               device frame (its transfers and the wait for it included) */
 } drape_garment_stats;
 
 DRAPE_API drape_result DRAPE_CALL drape_garment_get_stats(drape_garment* garment,

@@ -498,6 +498,12 @@ void GarmentSim::stepEnd() {
 }
 
 const std::vector<Vec3>& GarmentSim::normals() const {
+  // A device solver's normals of these positions, computed with its frame (docs/opencl.md).
+  if (const Eigen::Vector4f* dn = solver_->deviceNormals()) {
+    normals_.resize(particleCount());
+    for (size_t i = 0; i < normals_.size(); ++i) normals_[i] = dn[i].head<3>();
+    return normals_;
+  }
   normal_positions_.resize(particleCount());
   const Eigen::Vector4f* x = solver_->x();
   for (size_t i = 0; i < normal_positions_.size(); ++i) normal_positions_[i] = x[i].head<3>();
@@ -561,10 +567,16 @@ bool GarmentSim::replaceSolver(const SolverFactory& make, std::string& err) {
 
 bool GarmentSim::useCpuSolver(std::string& err) {
   if (backend() == GarmentBackend::Cpu) return true;
-  std::unique_ptr<Solver> next = makeSolver(kind_, topology_);
+  // Only the XPBD solver runs elsewhere (replaceSolver), so the way back is an XPBD solver.
+  auto next = std::make_unique<XpbdFace>(topology_);
   std::vector<Vec3> x(particleCount());
   for (size_t i = 0; i < x.size(); ++i) x[i] = solver_->x()[i].head<3>();
   if (!next->setParams(params_, err) || !next->reset(x, err)) return false;
+  // The device's velocities carry over (velocities() reads them back): the cloth keeps moving.
+  if (!next->s.setVelocities(solver_->v(), particleCount())) {
+    err = "the garment's velocities are not finite";
+    return false;
+  }
   solver_ = std::move(next);
   return true;
 }

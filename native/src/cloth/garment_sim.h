@@ -129,7 +129,8 @@ class GarmentSim {
   const std::vector<uint32_t>& indices() const { return mesh_.indices; }
   const GarmentTopology& topology() const { return topology_; }
   const GarmentMesh& mesh() const { return mesh_; }
-  // Area-weighted unit vertex normals of the current positions, computed on call into a buffer
+  // Area-weighted unit vertex normals of the current positions (on the OpenCL backend the
+  // device's, computed with the frame once the host reads normals: docs/opencl.md), into a buffer
   // the garment owns (valid until the next call; no allocation after the first).
   const std::vector<Vec3>& normals() const;
   // Collision groups: each particle belongs to the body chain nearest to it on the rest body and
@@ -174,7 +175,7 @@ class GarmentSim {
   // Replaces the XPBD solver by make(...)'s with the current params; false + err and nothing
   // changed when make or setParams fails, or for the mass-spring solver (CPU only).
   bool replaceSolver(const SolverFactory& make, std::string& err);
-  // Back to the CPU XPBD solver at the current positions (velocities restart at zero).
+  // Back to the CPU XPBD solver with the current positions and velocities.
   bool useCpuSolver(std::string& err);
   GarmentBackend backend() const;
   // Whether the solver's device failed (its last frame was not applied); the reason in *err.

@@ -25,6 +25,10 @@ struct GarmentSim::Solver {
   virtual const Eigen::Vector4f* x() const = 0;
   virtual Eigen::Vector4f* mutableX() = 0;  // xyz writable between steps
   virtual const Eigen::Vector4f* v() const = 0;
+  // Vertex normals the solver computed with its last frame for the current positions (xyz,
+  // w = 0), or null: GarmentSim::normals() then computes them on the CPU. A call also says the
+  // host reads normals, so a device solver computes them with its next frames (docs/opencl.md).
+  virtual const Eigen::Vector4f* deviceNormals() { return nullptr; }
   virtual CollisionStats collision() const = 0;
   virtual double collideMs() const = 0;
   // Backends (docs/opencl.md): which one runs the step, and for a device solver whether its

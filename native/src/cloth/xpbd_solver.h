@@ -98,6 +98,15 @@ class XpbdSolver {
   // Writable xyz for callers that constrain particles between steps (keep w as it is).
   Eigen::Vector4f* mutablePositions() { return x_.data(); }
   const Eigen::Vector4f* velocities() const { return v_.data(); }   // w = 0
+  // Every particle's velocity (xyz m/s, w ignored): a garment coming back from the OpenCL
+  // backend keeps its motion. False, nothing changed, on a wrong count or a non-finite value.
+  bool setVelocities(const Eigen::Vector4f* v, size_t count) {
+    if (v == nullptr || count != particleCount()) return false;
+    for (size_t i = 0; i < count; ++i)
+      if (!v[i].head<3>().allFinite()) return false;
+    for (size_t i = 0; i < count; ++i) v_[i] = Eigen::Vector4f(v[i].x(), v[i].y(), v[i].z(), 0.0f);
+    return true;
+  }
   // Collision statistics summed over the last step's substeps.
   const CollisionStats& lastCollisionStats() const { return collision_stats_; }
   // Off by default (two clock reads per substep part when on).

@@ -10,8 +10,10 @@ ClFrameBatch::ClFrameBatch(ClRuntime& runtime) : runtime_(runtime) {}
 ClFrameBatch::~ClFrameBatch() {
   if (frame_) clReleaseKernel(frame_);
   if (transform_) clReleaseKernel(transform_);
+  if (normals_) clReleaseKernel(normals_);
   for (Buffer* b : {&garments_, &x_, &prev_, &v_, &span_start_, &pin_start_, &pin_index_, &pin_target_, &constraints_,
-                    &groups_, &masks_, &shapes_, &bounds_, &stats_, &transforms_})
+                    &groups_, &masks_, &shapes_, &bounds_, &stats_, &transforms_, &work_, &triangles_, &face_offsets_,
+                    &vertex_faces_})
     if (b->mem) clReleaseMemObject(b->mem);
 }
 
@@ -33,7 +35,9 @@ bool ClFrameBatch::grow(cl_mem& buffer, size_t& capacity, size_t bytes, cl_mem_f
 
 bool ClFrameBatch::run(const std::vector<ClXpbdSolver*>& solvers, std::string& err) {
   std::lock_guard<std::mutex> lock(mutex_);
-  const bool ok = runLocked(solvers, err);
+  members_.assign(solvers.begin(), solvers.end());
+  std::stable_partition(members_.begin(), members_.end(), [](const ClXpbdSolver* s) { return !s->usesPhases(); });
+  const bool ok = runLocked(members_, err);
   for (ClXpbdSolver* s : solvers) {
     s->prepared_ = false;
     if (!ok) {
@@ -47,14 +51,15 @@ bool ClFrameBatch::run(const std::vector<ClXpbdSolver*>& solvers, std::string& e
 
 bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::string& err) {
   for (const ClXpbdSolver* s : solvers) {
-    if (!s->prepared_ || s->particleCount() == 0 || s->usesPhases() || &s->runtime() != &runtime_) {
-      err = "ClFrameBatch: a member is not a prepared one-work-group frame on this runtime";
+    if (!s->prepared_ || s->particleCount() == 0 || &s->runtime() != &runtime_) {
+      err = "ClFrameBatch: a member is not a prepared frame on this runtime";
       return false;
     }
   }
   cl_int rc = CL_SUCCESS;
   for (auto [kernel, name] : {std::pair<cl_kernel*, const char*>{&frame_, "drape_xpbd_frame"},
-                              std::pair<cl_kernel*, const char*>{&transform_, "drape_transform_batch"}}) {
+                              std::pair<cl_kernel*, const char*>{&transform_, "drape_transform_batch"},
+                              std::pair<cl_kernel*, const char*>{&normals_, "drape_vertex_normals"}}) {
     if (*kernel) continue;
     *kernel = clCreateKernel(runtime_.program(), name, &rc);
     if (rc != CL_SUCCESS) {
@@ -63,8 +68,12 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
       return false;
     }
   }
+  if (!phases_.create(runtime_.program(), err)) return false;
   // The table: each garment's record with its slices of the concatenated buffers.
   const size_t count = solvers.size();
+  size_t work_groups = 0;  // the leading one-work-group members
+  while (work_groups < count && !solvers[work_groups]->usesPhases()) ++work_groups;
+  plan_.clear(count);
   table_.resize(count);
   pin_targets_.clear();
   shapes_host_.clear();
@@ -90,31 +99,48 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
     shapes_host_.insert(shapes_host_.end(), s.shapes_.begin(), s.shapes_.end());
     bounds_host_.insert(bounds_host_.end(), s.bounds_.begin(), s.bounds_.end());
     layout.emplace_back(s.batch_id_, s.constraint_version_);
+    if (i >= work_groups)
+      plan_.setGarment(i, static_cast<uint32_t>(s.particleCount()), static_cast<uint32_t>(s.pin_index_.size()),
+                       s.group_offsets_, s.distance_groups_, s.tether_groups_);
   }
+  plan_.finish();
   const cl_mem_flags rw = CL_MEM_READ_WRITE, ro = CL_MEM_READ_ONLY;
   bool ok = grow(garments_.mem, garments_.capacity, count * sizeof(DrapeClGarment), ro) &&
-            grow(x_.mem, x_.capacity, particles * 16, rw) && grow(prev_.mem, prev_.capacity, particles * 16, rw) &&
+            grow(x_.mem, x_.capacity, 2 * particles * 16, rw) &&  // positions, then normals
+            grow(prev_.mem, prev_.capacity, particles * 16, rw) &&
             grow(v_.mem, v_.capacity, particles * 16, rw) &&
             grow(span_start_.mem, span_start_.capacity, particles * 16, rw) &&
             grow(pin_start_.mem, pin_start_.capacity, pins * 16, rw) &&
             grow(pin_target_.mem, pin_target_.capacity, pins * 16, ro) &&
             grow(shapes_.mem, shapes_.capacity, shapes_host_.size() * sizeof(DrapeClShape), ro) &&
             grow(bounds_.mem, bounds_.capacity, bounds_host_.size() * 16, ro) &&
-            grow(stats_.mem, stats_.capacity, count * sizeof(DrapeClStats), rw);
+            grow(stats_.mem, stats_.capacity, count * sizeof(DrapeClStats), rw) &&
+            grow(work_.mem, work_.capacity, plan_.work().size() * 4, ro);
   // Static data: again only when a member or its constraints (inv_w for a new h) changed. A
   // reallocated static buffer forgets its contents, so it forces the upload too.
   const size_t pin_index_cap = pin_index_.capacity, constraint_cap = constraints_.capacity,
-               group_cap = groups_.capacity, mask_cap = masks_.capacity;
+               group_cap = groups_.capacity, mask_cap = masks_.capacity, triangle_cap = triangles_.capacity,
+               face_offset_cap = face_offsets_.capacity, vertex_face_cap = vertex_faces_.capacity;
+  size_t triangle_indices = 0, face_entries = 0;
+  for (const ClXpbdSolver* s : solvers) {
+    triangle_indices += s->normal_tables_.indices.size();
+    face_entries += s->normal_tables_.vertex_faces.size();
+  }
   ok = ok && grow(pin_index_.mem, pin_index_.capacity, pins * 4, ro) &&
        grow(constraints_.mem, constraints_.capacity, constraints * sizeof(DrapeClConstraint), ro) &&
-       grow(groups_.mem, groups_.capacity, groups * 4, ro) && grow(masks_.mem, masks_.capacity, particles, ro);
+       grow(groups_.mem, groups_.capacity, groups * 4, ro) && grow(masks_.mem, masks_.capacity, particles, ro) &&
+       grow(triangles_.mem, triangles_.capacity, triangle_indices * 4, ro) &&
+       grow(face_offsets_.mem, face_offsets_.capacity, (particles + 1) * 4, ro) &&
+       grow(vertex_faces_.mem, vertex_faces_.capacity, face_entries * 4, ro);
   if (!ok) {
     layout_.clear();
     err = "OpenCL batch buffer allocation failed";
     return false;
   }
   const bool reallocated = pin_index_cap != pin_index_.capacity || constraint_cap != constraints_.capacity ||
-                           group_cap != groups_.capacity || mask_cap != masks_.capacity;
+                           group_cap != groups_.capacity || mask_cap != masks_.capacity ||
+                           triangle_cap != triangles_.capacity || face_offset_cap != face_offsets_.capacity ||
+                           vertex_face_cap != vertex_faces_.capacity;
   cl_command_queue q = runtime_.queue();
   auto write = [&](cl_mem m, size_t offset, const void* data, size_t bytes) {
     if (rc == CL_SUCCESS && bytes > 0) rc = clEnqueueWriteBuffer(q, m, CL_FALSE, offset, bytes, data, 0, nullptr, nullptr);
@@ -128,7 +154,9 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
     groups_host_.clear();
     pin_index_host_.clear();
     masks_host_.clear();
+    normal_tables_.clear();
     for (const ClXpbdSolver* s : solvers) {
+      normal_tables_.append(s->topology_.triangles, s->particleCount());  // checked by the solver
       // Group table entries index the concatenated constraints.
       const uint32_t base = static_cast<uint32_t>(constraints_host_.size());
       for (uint32_t o : s->group_offsets_) groups_host_.push_back(base + o);
@@ -143,12 +171,16 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
     write(groups_.mem, 0, groups_host_.data(), groups_host_.size() * 4);
     write(pin_index_.mem, 0, pin_index_host_.data(), pin_index_host_.size() * 4);
     write(masks_.mem, 0, masks_host_.data(), masks_host_.size());
+    write(triangles_.mem, 0, normal_tables_.indices.data(), normal_tables_.indices.size() * 4);
+    write(face_offsets_.mem, 0, normal_tables_.face_offsets.data(), normal_tables_.face_offsets.size() * 4);
+    write(vertex_faces_.mem, 0, normal_tables_.vertex_faces.data(), normal_tables_.vertex_faces.size() * 4);
     if (rc == CL_SUCCESS) layout_ = layout;
   }
   write(garments_.mem, 0, table_.data(), count * sizeof(DrapeClGarment));
   write(pin_target_.mem, 0, pin_targets_.data(), pin_targets_.size() * 16);
   write(shapes_.mem, 0, shapes_host_.data(), shapes_host_.size() * sizeof(DrapeClShape));
   write(bounds_.mem, 0, bounds_host_.data(), bounds_host_.size() * 16);
+  if (plan_.any()) write(work_.mem, 0, plan_.work().data(), plan_.work().size() * 4);
   // The garments' state in (device to device): positions and velocities. prev, span_start and
   // pin_start are scratch the kernel writes before it reads them.
   for (size_t i = 0; i < count; ++i) {
@@ -185,12 +217,15 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
   const cl_mem args[14] = {garments_.mem, x_.mem,           prev_.mem,         v_.mem,      span_start_.mem,
                            pin_start_.mem, pin_index_.mem,  pin_target_.mem,   constraints_.mem, groups_.mem,
                            masks_.mem,    shapes_.mem,      bounds_.mem,       stats_.mem};
-  for (cl_uint a = 0; a < 14 && rc == CL_SUCCESS; ++a) rc = clSetKernelArg(frame_, a, sizeof(cl_mem), &args[a]);
-  if (rc == CL_SUCCESS) {
-    const size_t wg = runtime_.workGroup(), global = wg * count;
+  for (cl_uint a = 0; a < 14 && rc == CL_SUCCESS && work_groups > 0; ++a)
+    rc = clSetKernelArg(frame_, a, sizeof(cl_mem), &args[a]);
+  if (rc == CL_SUCCESS && work_groups > 0) {
+    const size_t wg = runtime_.workGroup(), global = wg * work_groups;
     rc = clEnqueueNDRangeKernel(q, frame_, 1, nullptr, &global, &wg, 0, nullptr, nullptr);
     runtime_.countLaunches();
   }
+  // The per-phase members: each phase once for all of them (their own substep loop).
+  if (rc == CL_SUCCESS && plan_.any()) rc = enqueuePhases();
   // The state back to each garment's own buffers (its transform, velocities() and a later
   // solo frame use them), then one readback of every position and counter.
   for (size_t i = 0; i < count; ++i) {
@@ -198,12 +233,30 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
     copy(x_.mem, size_t{table_[i].particle_offset} * 16, solvers[i]->x_buf_, 0, bytes);
     copy(v_.mem, size_t{table_[i].particle_offset} * 16, solvers[i]->v_buf_, 0, bytes);
   }
+  // Normals of every member when one asked for them (the same kernel and arithmetic as a
+  // garment's own frame), written after the positions.
+  bool normals = false;
+  for (const ClXpbdSolver* s : solvers) normals = normals || s->normals_frame_;
+  if (normals && rc == CL_SUCCESS) {
+    const cl_uint n = static_cast<cl_uint>(particles);
+    const cl_mem nargs[4] = {x_.mem, triangles_.mem, face_offsets_.mem, vertex_faces_.mem};
+    for (cl_uint a = 0; a < 4 && rc == CL_SUCCESS; ++a) rc = clSetKernelArg(normals_, a, sizeof(cl_mem), &nargs[a]);
+    if (rc == CL_SUCCESS) rc = clSetKernelArg(normals_, 4, sizeof(n), &n);
+    if (rc == CL_SUCCESS) rc = clSetKernelArg(normals_, 5, sizeof(cl_mem), &x_.mem);
+    if (rc == CL_SUCCESS) rc = clSetKernelArg(normals_, 6, sizeof(n), &n);
+    const size_t global = (particles + 63) / 64 * 64;
+    if (rc == CL_SUCCESS) {
+      rc = clEnqueueNDRangeKernel(q, normals_, 1, nullptr, &global, nullptr, 0, nullptr, nullptr);
+      runtime_.countLaunches();
+    }
+  }
+  const size_t rows = normals ? 2 * particles : particles;
   stats_host_.resize(count);
-  x_host_.resize(particles);
+  x_host_.resize(rows);
   if (rc == CL_SUCCESS)
     rc = clEnqueueReadBuffer(q, stats_.mem, CL_FALSE, 0, count * sizeof(DrapeClStats), stats_host_.data(), 0, nullptr, nullptr);
   if (rc == CL_SUCCESS)
-    rc = clEnqueueReadBuffer(q, x_.mem, CL_TRUE, 0, particles * 16, x_host_.data(), 0, nullptr, nullptr);
+    rc = clEnqueueReadBuffer(q, x_.mem, CL_TRUE, 0, rows * 16, x_host_.data(), 0, nullptr, nullptr);
   if (rc == CL_SUCCESS) rc = clFinish(q);
   if (rc != CL_SUCCESS) {
     layout_.clear();  // the static uploads may not have landed
@@ -215,12 +268,26 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
     std::copy(x_host_.begin() + static_cast<long>(size_t{table_[i].particle_offset}),
               x_host_.begin() + static_cast<long>(size_t{table_[i].particle_offset} + s.particleCount()), s.x_.begin());
     s.v_stale_ = true;
+    s.normals_valid_ = normals;
+    if (normals) {
+      const auto from = x_host_.begin() + static_cast<long>(particles + size_t{table_[i].particle_offset});
+      s.normals_.assign(from, from + static_cast<long>(s.particleCount()));
+    }
     s.collision_stats_.tests = stats_host_[i].tests;
     s.collision_stats_.contacts = stats_host_[i].contacts;
     s.collision_stats_.swept_catches = stats_host_[i].swept_catches;
     s.collision_stats_.escapes = stats_host_[i].escapes;
   }
   return true;
+}
+
+cl_int ClFrameBatch::enqueuePhases() {
+  ClPhaseBuffers b;
+  b.table = garments_.mem, b.work = work_.mem, b.x = x_.mem, b.prev = prev_.mem, b.v = v_.mem;
+  b.span_start = span_start_.mem, b.pin_start = pin_start_.mem, b.pin_index = pin_index_.mem;
+  b.pin_target = pin_target_.mem, b.constraints = constraints_.mem, b.groups = groups_.mem, b.masks = masks_.mem;
+  b.shapes = shapes_.mem, b.bounds = bounds_.mem, b.stats = stats_.mem;
+  return phases_.enqueue(runtime_, b, plan_, table_.data(), nullptr, nullptr);
 }
 
 }  // namespace drape

@@ -7,6 +7,7 @@
 // garment's own launch, so the results are the same bits (tested).
 #pragma once
 
+#include "backends/opencl/cl_phase_launch.h"
 #include "backends/opencl/cl_xpbd_solver.h"
 
 #include <mutex>
@@ -23,8 +24,10 @@ class ClFrameBatch {
   ClFrameBatch(const ClFrameBatch&) = delete;
   ClFrameBatch& operator=(const ClFrameBatch&) = delete;
 
-  // Runs the prepared frames (prepareFrame() returned true) of `solvers`, all on this runtime, on
-  // the one-work-group path (!usesPhases()) and non-empty, as one launch. The garments' own
+  // Runs the prepared frames (prepareFrame() returned true) of `solvers`, all on this runtime and
+  // non-empty: the one-work-group garments (!usesPhases()) in one launch of the frame kernel, the
+  // per-phase ones (large garments) in one launch per phase for all of them (ClPhaseKernels:
+  // the launches of one large garment, whatever their number). The garments' own
   // device state (positions, velocities) is copied into the batch buffers and back on the device
   // (no host transfer); the per-frame arrays (garment table, pin targets, shapes, span bounds)
   // go up once for the batch, positions and counters come back once. Constraints, the group
@@ -35,6 +38,7 @@ class ClFrameBatch {
  private:
   bool grow(cl_mem& buffer, size_t& capacity, size_t bytes, cl_mem_flags flags);
   bool runLocked(const std::vector<ClXpbdSolver*>& solvers, std::string& err);
+  cl_int enqueuePhases();
 
   ClRuntime& runtime_;
   std::mutex mutex_;  // contexts on other threads may share the runtime
@@ -44,7 +48,18 @@ class ClFrameBatch {
     size_t capacity = 0;
   };
   Buffer garments_, x_, prev_, v_, span_start_, pin_start_, pin_index_, pin_target_, constraints_, groups_,
-      masks_, shapes_, bounds_, stats_, transforms_;
+      masks_, shapes_, bounds_, stats_, transforms_, work_, triangles_, face_offsets_, vertex_faces_;
+  // Normals: when a member asked for them (requestNormals), one drape_vertex_normals launch over
+  // every member's particles (the tables of all their meshes, static like the constraints), into
+  // x_ after the positions, which then come back with them in one readback.
+  cl_kernel normals_ = nullptr;
+  ClNormalTables normal_tables_;
+  // The per-phase garments' launches: the table's work rows (ClPhasePlan), rebuilt per frame.
+  ClPhaseKernels phases_;
+  ClPhasePlan plan_;
+  // run()'s members in table order: the one-work-group garments first (work-group g of the
+  // frame kernel = table entry g), then the per-phase ones.
+  std::vector<ClXpbdSolver*> members_;
   // The members (solver id, constraint version) whose static data the device holds.
   std::vector<std::pair<uint64_t, uint64_t>> layout_;
   std::vector<std::pair<uint64_t, uint64_t>> next_layout_;  // run()'s scratch: this frame's members

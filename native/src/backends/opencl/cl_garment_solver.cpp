@@ -58,8 +58,13 @@ struct ClXpbdFace final : GarmentSim::Solver {
     return s->mutablePositions();
   }
   const Eigen::Vector4f* v() const override { return s->velocities(); }
+  const Eigen::Vector4f* deviceNormals() override {
+    s->requestNormals();  // the next frames compute them on the device
+    return s->deviceNormals();
+  }
   CollisionStats collision() const override { return s->lastCollisionStats(); }
-  // Collision runs inside the frame kernel with the rest of the step: no separate time.
+  // Collision runs inside the frame kernel with the rest of the step: no separate time. 0, so the
+  // stats' integrate_ms (step minus collide) holds the whole device frame (docs/opencl.md, drape.h).
   double collideMs() const override { return 0.0; }
   GarmentBackend backend() const override { return GarmentBackend::OpenCl; }
   bool deviceFailed(std::string* err) const override {
@@ -90,8 +95,9 @@ void setClFrameBatching(bool on) { g_batching = on; }
 bool clFrameBatching() { return g_batching.load(); }
 
 size_t runStagedClFrames(const std::vector<GarmentSim*>& garments) {
-  // Group the staged device frames by runtime; a group's one-work-group frames run as one batch
-  // when there are two or more, the rest (per-phase garments, a lone garment) alone.
+  // Group the staged device frames by runtime; a group's frames run as one batch when there are
+  // two or more (one frame launch for the one-work-group garments, one launch per phase for the
+  // large ones), a lone garment alone.
   std::vector<std::pair<ClRuntime*, std::vector<ClXpbdFace*>>> by_runtime;
   for (GarmentSim* g : garments) {
     auto* face = g ? dynamic_cast<ClXpbdFace*>(g->solverFace()) : nullptr;
@@ -108,7 +114,7 @@ size_t runStagedClFrames(const std::vector<GarmentSim*>& garments) {
   for (auto& [rt, faces] : by_runtime) {
     std::vector<ClXpbdFace*> together;
     for (ClXpbdFace* f : faces) {
-      if (f->s->particleCount() > 0 && !f->s->usesPhases()) {
+      if (f->s->particleCount() > 0) {
         together.push_back(f);
       } else {
         f->runStaged();

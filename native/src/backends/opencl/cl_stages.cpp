@@ -174,6 +174,7 @@ bool clVertexNormals(ClRuntime& rt, const std::vector<DclF4>& x, const std::vect
   l.arg(3, fb);
   l.arg(4, static_cast<cl_uint>(n));
   l.arg(5, nb);
+  l.arg(6, cl_uint{0});
   l.run(n);
   l.read(nb, normals.data(), n * 16);
   l.times(times);

@@ -37,54 +37,39 @@ void release(cl_mem& m) {
 
 }  // namespace
 
-bool ClXpbdSolver::enqueuePhases(const DrapeClGarment& g, std::vector<cl_event>& runs) {
-  cl_command_queue q = runtime_->queue();
-  cl_int rc = CL_SUCCESS;
-  const size_t n = particleCount();
-  auto launch = [&](cl_kernel k, size_t items, bool keep_event) {
-    if (rc != CL_SUCCESS || items == 0) return;
-    const size_t global = (items + 63) / 64 * 64;
-    cl_event e = nullptr;
-    rc = clEnqueueNDRangeKernel(q, k, 1, nullptr, &global, nullptr, 0, nullptr, keep_event ? &e : nullptr);
-    runtime_->countLaunches();
-    if (rc == CL_SUCCESS && keep_event) runs.push_back(e);
-  };
-  auto arg = [&](cl_kernel k, cl_uint i, auto v) {
-    if (rc == CL_SUCCESS) rc = clSetKernelArg(k, i, sizeof(v), &v);
-  };
-  // The first launch keeps its event (start of the kernel time), as does the last (below).
-  launch(clear_stats_, 1, true);
-  launch(pin_start_, pin_index_.size(), false);
-  const int stride = g.stride;
-  int span0 = 0, span = 0;
-  for (int s = 0; s < g.substeps; ++s) {
-    const bool collide = (s + 1 - span0) >= stride || s + 1 == g.substeps;
-    arg(predict_, 5, static_cast<cl_int>(stride > 1 && s == span0));
-    launch(predict_, n, false);
-    arg(pins_, 5, static_cast<cl_int>(s));
-    launch(pins_, pin_index_.size(), false);
-    for (int it = 0; it < g.iterations; ++it) {
-      for (uint32_t c = 0; c < distance_groups_ + tether_groups_; ++c) {
-        const bool tether = c >= distance_groups_;
-        const uint32_t at = tether ? distance_groups_ + 1 + (c - distance_groups_) : c;
-        const cl_uint begin = group_offsets_[at], end = group_offsets_[at + 1];
-        arg(project_, 2, begin);
-        arg(project_, 3, end);
-        arg(project_, 4, static_cast<cl_uint>(tether ? 1 : 0));
-        arg(project_, 5, g.tether_scale);
-        launch(project_, end - begin, false);
-      }
-    }
-    arg(collide_velocity_, 9, static_cast<cl_int>(collide ? 1 : 0));
-    arg(collide_velocity_, 10, static_cast<cl_int>(span));
-    launch(collide_velocity_, n, s + 1 == g.substeps);
-    if (collide) {
-      span0 = s + 1;
-      ++span;
-    }
-  }
+bool ClXpbdSolver::enqueuePhases(std::vector<cl_event>& runs) {
+  ClPhaseBuffers b;
+  b.table = garment_, b.work = work_buf_, b.x = x_buf_, b.prev = prev_buf_, b.v = v_buf_;
+  b.span_start = span_start_buf_, b.pin_start = pin_start_buf_, b.pin_index = pin_index_buf_;
+  b.pin_target = pin_target_buf_, b.constraints = constraint_buf_, b.groups = group_buf_, b.masks = mask_buf_;
+  b.shapes = shape_buf_, b.bounds = bounds_buf_, b.stats = stats_buf_;
+  // The first and the last launch keep their events: the kernel time spans them.
+  cl_event first = nullptr, last = nullptr;
+  const cl_int rc = phases_.enqueue(*runtime_, b, phase_plan_, &frame_g_, &first, &last);
+  for (cl_event e : {first, last})
+    if (e) runs.push_back(e);
   if (rc != CL_SUCCESS) {
     device_error_ = std::string("OpenCL phase launch failed (") + clErrorName(rc) + ")";
+    return false;
+  }
+  return true;
+}
+
+bool ClXpbdSolver::enqueueNormals() {
+  const cl_uint n = static_cast<cl_uint>(particleCount());
+  cl_int rc = CL_SUCCESS;
+  auto arg = [&](cl_uint i, auto v) {
+    if (rc == CL_SUCCESS) rc = clSetKernelArg(normals_kernel_, i, sizeof(v), &v);
+  };
+  arg(0, x_buf_), arg(1, tri_buf_), arg(2, face_offset_buf_), arg(3, vertex_face_buf_), arg(4, n), arg(5, x_buf_),
+      arg(6, n);
+  const size_t global = (size_t{n} + 63) / 64 * 64;
+  if (rc == CL_SUCCESS) {
+    rc = clEnqueueNDRangeKernel(runtime_->queue(), normals_kernel_, 1, nullptr, &global, nullptr, 0, nullptr, nullptr);
+    runtime_->countLaunches();
+  }
+  if (rc != CL_SUCCESS) {
+    device_error_ = std::string("OpenCL normals launch failed (") + clErrorName(rc) + ")";
     return false;
   }
   return true;
@@ -99,6 +84,9 @@ bool ClXpbdSolver::prepareFrame(float dt, int substeps) {
   collision_stats_ = CollisionStats{};
   const size_t n = particleCount();
   prepared_ = true;
+  // Normals with this frame when the host read them since the last one (requestNormals).
+  normals_frame_ = normals_requested_;
+  normals_requested_ = false;
   if (n == 0) return true;
   const auto host0 = Clock::now();
   const float h = dt / static_cast<float>(substeps);
@@ -172,14 +160,12 @@ bool ClXpbdSolver::runPreparedFrame() {
     shape_capacity_ = shapes_.size() * 2;
     shape_buf_ = clCreateBuffer(runtime_->context(), CL_MEM_READ_ONLY, shape_capacity_ * sizeof(DrapeClShape), nullptr, &rc);
     if (rc == CL_SUCCESS) rc = clSetKernelArg(frame_, 11, sizeof(cl_mem), &shape_buf_);
-    if (rc == CL_SUCCESS) rc = clSetKernelArg(collide_velocity_, 6, sizeof(cl_mem), &shape_buf_);
   }
   if (rc == CL_SUCCESS && bounds_.size() > bounds_capacity_) {
     release(bounds_buf_);
     bounds_capacity_ = bounds_.size() * 2;
     bounds_buf_ = clCreateBuffer(runtime_->context(), CL_MEM_READ_ONLY, bounds_capacity_ * 16, nullptr, &rc);
     if (rc == CL_SUCCESS) rc = clSetKernelArg(frame_, 12, sizeof(cl_mem), &bounds_buf_);
-    if (rc == CL_SUCCESS) rc = clSetKernelArg(collide_velocity_, 7, sizeof(cl_mem), &bounds_buf_);
   }
   if (rc != CL_SUCCESS) {
     device_error_ = std::string("OpenCL shape buffer failed (") + clErrorName(rc) + ")";
@@ -196,7 +182,7 @@ bool ClXpbdSolver::runPreparedFrame() {
     constraints_dirty_ = !ok;
   }
   if (ok && usesPhases()) {
-    ok = enqueuePhases(g, runs);
+    ok = enqueuePhases(runs);
   } else if (ok) {
     const size_t wg = runtime_->workGroup();
     cl_event e = nullptr;
@@ -209,15 +195,19 @@ bool ClXpbdSolver::runPreparedFrame() {
       ok = false;
     }
   }
+  normals_valid_ = false;
+  if (ok && normals_frame_) ok = enqueueNormals();
+  // Positions, and after them the normals when the frame computed them: one readback.
+  const size_t rows = normals_frame_ ? 2 * n : n;
   DrapeClStats stats{};
   std::vector<Eigen::Vector4f> x_back;
   if (ok) {
-    x_back.resize(n);
+    x_back.resize(rows);
     cl_event e1 = nullptr, e2 = nullptr;
     rc = clEnqueueReadBuffer(runtime_->queue(), stats_buf_, CL_FALSE, 0, sizeof(stats), &stats, 0, nullptr, &e1);
     if (rc == CL_SUCCESS) {
       reads.push_back(e1);
-      rc = clEnqueueReadBuffer(runtime_->queue(), x_buf_, CL_TRUE, 0, n * 16, x_back.data(), 0, nullptr, &e2);
+      rc = clEnqueueReadBuffer(runtime_->queue(), x_buf_, CL_TRUE, 0, rows * 16, x_back.data(), 0, nullptr, &e2);
       if (rc == CL_SUCCESS) reads.push_back(e2);
     }
     if (rc == CL_SUCCESS) rc = clFinish(runtime_->queue());
@@ -245,6 +235,11 @@ bool ClXpbdSolver::runPreparedFrame() {
     clFinish(runtime_->queue());
     uploadState();  // the device state may be half-stepped: restore the last good one
     return false;
+  }
+  if (normals_frame_) {
+    normals_.assign(x_back.begin() + static_cast<long>(n), x_back.end());
+    x_back.resize(n);
+    normals_valid_ = true;
   }
   x_.swap(x_back);
   v_stale_ = true;

@@ -77,9 +77,9 @@ std::unique_ptr<ClXpbdSolver> ClXpbdSolver::create(std::shared_ptr<ClRuntime> ru
 }
 
 ClXpbdSolver::~ClXpbdSolver() {
-  for (cl_kernel k : {frame_, transform_, predict_, pins_, pin_start_, project_, collide_velocity_, clear_stats_})
+  for (cl_kernel k : {frame_, transform_, normals_kernel_})
     if (k) clReleaseKernel(k);
-  for (cl_mem* m : {&garment_, &x_buf_, &prev_buf_, &v_buf_, &span_start_buf_, &pin_start_buf_, &pin_index_buf_,
+  for (cl_mem* m : {&work_buf_, &tri_buf_, &face_offset_buf_, &vertex_face_buf_, &garment_, &x_buf_, &prev_buf_, &v_buf_, &span_start_buf_, &pin_start_buf_, &pin_index_buf_,
                     &pin_target_buf_, &constraint_buf_, &group_buf_, &mask_buf_, &shape_buf_, &bounds_buf_,
                     &stats_buf_})
     release(*m);
@@ -95,7 +95,7 @@ bool ClXpbdSolver::allocate(std::string& err) {
     m = clCreateBuffer(ctx, CL_MEM_READ_WRITE, bytes, nullptr, &rc);
   };
   make(garment_, sizeof(DrapeClGarment));
-  make(x_buf_, n * 16);
+  make(x_buf_, 2 * n * 16);  // positions, then the frame's normals (when asked for)
   make(prev_buf_, n * 16);
   make(v_buf_, n * 16);
   make(span_start_buf_, n * 16);
@@ -115,9 +115,7 @@ bool ClXpbdSolver::allocate(std::string& err) {
     return false;
   }
   const std::pair<cl_kernel*, const char*> kernels[] = {
-      {&frame_, "drape_xpbd_frame"}, {&transform_, "drape_transform"}, {&predict_, "drape_phase_predict"},
-      {&pins_, "drape_phase_pins"}, {&pin_start_, "drape_phase_pin_start"}, {&project_, "drape_project_group"},
-      {&collide_velocity_, "drape_phase_collide_velocity"}, {&clear_stats_, "drape_phase_clear_stats"}};
+      {&frame_, "drape_xpbd_frame"}, {&transform_, "drape_transform"}, {&normals_kernel_, "drape_vertex_normals"}};
   for (const auto& k : kernels) {
     if (rc == CL_SUCCESS) *k.first = clCreateKernel(runtime_->program(), k.second, &rc);
     if (rc != CL_SUCCESS) *k.first = nullptr;
@@ -126,25 +124,23 @@ bool ClXpbdSolver::allocate(std::string& err) {
     err = std::string("clCreateKernel failed (") + clErrorName(rc) + ")";
     return false;
   }
+  if (!phases_.create(runtime_->program(), err)) return false;
+  phase_plan_.clear(1);
+  phase_plan_.setGarment(0, static_cast<uint32_t>(particleCount()), static_cast<uint32_t>(pin_index_.size()),
+                         group_offsets_, distance_groups_, tether_groups_);
+  phase_plan_.finish();
+  make(work_buf_, phase_plan_.work().size() * 4);
+  if (!normal_tables_.append(topology_.triangles, particleCount())) {
+    err = "a triangle index is out of range";
+    return false;
+  }
+  make(tri_buf_, std::max<size_t>(1, normal_tables_.indices.size()) * 4);
+  make(face_offset_buf_, normal_tables_.face_offsets.size() * 4);
+  make(vertex_face_buf_, std::max<size_t>(1, normal_tables_.vertex_faces.size()) * 4);
   const cl_mem args[] = {garment_, x_buf_, prev_buf_, v_buf_, span_start_buf_, pin_start_buf_, pin_index_buf_,
                          pin_target_buf_, constraint_buf_, group_buf_, mask_buf_, shape_buf_, bounds_buf_,
                          stats_buf_};
   for (cl_uint i = 0; i < 14 && rc == CL_SUCCESS; ++i) rc = clSetKernelArg(frame_, i, sizeof(cl_mem), &args[i]);
-  // The per-phase kernels' buffer arguments (the rest are set per launch).
-  auto set = [&](cl_kernel k, cl_uint i, const cl_mem& m) {
-    if (rc == CL_SUCCESS) rc = clSetKernelArg(k, i, sizeof(cl_mem), &m);
-  };
-  set(predict_, 0, garment_), set(predict_, 1, x_buf_), set(predict_, 2, prev_buf_), set(predict_, 3, v_buf_),
-      set(predict_, 4, span_start_buf_);
-  set(pins_, 0, garment_), set(pins_, 1, x_buf_), set(pins_, 2, pin_start_buf_), set(pins_, 3, pin_index_buf_),
-      set(pins_, 4, pin_target_buf_);
-  set(pin_start_, 0, garment_), set(pin_start_, 1, x_buf_), set(pin_start_, 2, pin_start_buf_),
-      set(pin_start_, 3, pin_index_buf_);
-  set(project_, 0, x_buf_), set(project_, 1, constraint_buf_);
-  set(collide_velocity_, 0, garment_), set(collide_velocity_, 1, x_buf_), set(collide_velocity_, 2, prev_buf_),
-      set(collide_velocity_, 3, v_buf_), set(collide_velocity_, 4, span_start_buf_), set(collide_velocity_, 5, mask_buf_),
-      set(collide_velocity_, 6, shape_buf_), set(collide_velocity_, 7, bounds_buf_), set(collide_velocity_, 8, stats_buf_);
-  set(clear_stats_, 0, stats_buf_);
   // Static data once: pin indices, group table, masks (0xFF: every group when none given).
   std::vector<uint8_t> masks(masks_);
   masks.resize(n, 0xFF);
@@ -155,6 +151,14 @@ bool ClXpbdSolver::allocate(std::string& err) {
   if (rc == CL_SUCCESS)
     rc = clEnqueueWriteBuffer(q, group_buf_, CL_TRUE, 0, group_offsets_.size() * 4, group_offsets_.data(), 0, nullptr, nullptr);
   if (rc == CL_SUCCESS) rc = clEnqueueWriteBuffer(q, mask_buf_, CL_TRUE, 0, n, masks.data(), 0, nullptr, nullptr);
+  if (rc == CL_SUCCESS)
+    rc = clEnqueueWriteBuffer(q, work_buf_, CL_TRUE, 0, phase_plan_.work().size() * 4, phase_plan_.work().data(), 0,
+                              nullptr, nullptr);
+  for (const auto& [buffer, table] : {std::pair<cl_mem, const std::vector<uint32_t>*>{tri_buf_, &normal_tables_.indices},
+                                      {face_offset_buf_, &normal_tables_.face_offsets},
+                                      {vertex_face_buf_, &normal_tables_.vertex_faces}})
+    if (rc == CL_SUCCESS && !table->empty())
+      rc = clEnqueueWriteBuffer(q, buffer, CL_TRUE, 0, table->size() * 4, table->data(), 0, nullptr, nullptr);
   if (rc != CL_SUCCESS) {
     err = std::string("OpenCL setup failed (") + clErrorName(rc) + ")";
     return false;
@@ -180,6 +184,7 @@ bool ClXpbdSolver::upload(cl_mem buffer, const void* data, size_t bytes, std::ve
 }
 
 bool ClXpbdSolver::uploadState() {
+  normals_valid_ = false;
   flushTransform();  // then overwritten: the device ends as the host copy, as before deferral
   if (particleCount() == 0) return true;
   const size_t bytes = particleCount() * 16;
@@ -188,6 +193,7 @@ bool ClXpbdSolver::uploadState() {
 }
 
 bool ClXpbdSolver::pushPositions() {
+  normals_valid_ = false;
   flushTransform();  // the velocities still need it
   if (particleCount() == 0) return true;
   return upload(x_buf_, x_.data(), particleCount() * 16, nullptr);
@@ -251,6 +257,7 @@ bool ClXpbdSolver::setColliderMotion(const Ellipsoid* start, const Ellipsoid* en
 }
 
 void ClXpbdSolver::transform(const Mat3& R, const Vec3& pivot, const Vec3& t, float velocity_scale) {
+  normals_valid_ = false;
   const Vec3 shift = pivot + t;
   for (size_t i = 0; i < particleCount(); ++i) x_[i].head<3>() = R * (Vec3(x_[i].head<3>()) - pivot) + shift;
   if (!v_stale_)

@@ -7,6 +7,8 @@
 // Velocities and the previous positions stay on the device; velocities() reads them on demand.
 #pragma once
 
+#include "backends/opencl/cl_normals.h"
+#include "backends/opencl/cl_phase_launch.h"
 #include "backends/opencl/cl_runtime.h"
 #include "cloth/xpbd_solver.h"
 #include "drape_cl_types.h"
@@ -65,9 +67,19 @@ class ClXpbdSolver {
   const GarmentTopology& topology() const { return topology_; }
   const Eigen::Vector4f* positions() const { return x_.data(); }
   // Writable xyz between steps (keep w); pushPositions() then sends them to the device.
-  Eigen::Vector4f* mutablePositions() { return x_.data(); }
+  Eigen::Vector4f* mutablePositions() {
+    normals_valid_ = false;
+    return x_.data();
+  }
   bool pushPositions();
   const Eigen::Vector4f* velocities() const;  // read from the device on demand
+  // Vertex normals on the device (docs/opencl.md, "Normals"). requestNormals(): the host wants
+  // normals, so the next frame runs drape_vertex_normals on its new positions and reads them
+  // back with the positions (the same transfer). deviceNormals(): those of the current
+  // positions (xyz, w = 0), or null when the last frame ran without them or the positions have
+  // changed since (the caller then computes them on the CPU).
+  void requestNormals() { normals_requested_ = true; }
+  const Eigen::Vector4f* deviceNormals() const { return normals_valid_ ? normals_.data() : nullptr; }
   const CollisionStats& lastCollisionStats() const { return collision_stats_; }
   const ClStepTimings& lastTimings() const { return timings_; }
   const std::string& lastError() const { return device_error_; }
@@ -128,12 +140,22 @@ class ClXpbdSolver {
   DrapeClTransform pending_transform_{};
   bool transform_pending_ = false;
 
-  bool enqueuePhases(const DrapeClGarment& g, std::vector<cl_event>& runs);
+  bool enqueuePhases(std::vector<cl_event>& runs);
   Path path_ = Path::Auto;
   cl_kernel frame_ = nullptr, transform_ = nullptr;
-  // The per-phase kernels (large garments).
-  cl_kernel predict_ = nullptr, pins_ = nullptr, pin_start_ = nullptr, project_ = nullptr,
-            collide_velocity_ = nullptr, clear_stats_ = nullptr;
+  // The per-phase kernels (large garments) over a table of this one garment; its work rows
+  // (static: they depend on the topology only) in work_buf_.
+  ClPhaseKernels phases_;
+  ClPhasePlan phase_plan_;
+  cl_mem work_buf_ = nullptr;
+  // Normals: the mesh's vertex -> triangle tables (static), the kernel, the last frame's
+  // normals. x_buf_ holds 2 n float4: positions, then the normals the frame computed.
+  bool enqueueNormals();
+  ClNormalTables normal_tables_;
+  cl_kernel normals_kernel_ = nullptr;
+  cl_mem tri_buf_ = nullptr, face_offset_buf_ = nullptr, vertex_face_buf_ = nullptr;
+  std::vector<Eigen::Vector4f> normals_;
+  bool normals_requested_ = false, normals_frame_ = false, normals_valid_ = false;
   cl_mem garment_ = nullptr, x_buf_ = nullptr, prev_buf_ = nullptr, v_buf_ = nullptr,
          span_start_buf_ = nullptr, pin_start_buf_ = nullptr, pin_index_buf_ = nullptr,
          pin_target_buf_ = nullptr, constraint_buf_ = nullptr, group_buf_ = nullptr,

@@ -1,0 +1,196 @@
+/* Large garments: the frame of drape_xpbd_frame as one launch per phase over global memory,
+ * one work-item per particle (or pin, or constraint), so every compute unit takes part. Every
+ * kernel takes the garment table, so one launch runs the phase for every per-phase garment of
+ * a batch (one garment alone is a table of one: the same kernels, the same bits).
+ *
+ * `work` holds rows of count + 1 entries, each the exclusive prefix of per-garment item counts
+ * (the host builds it, ClPhasePlan): row 0 particles, row 1 pins, then one row per distance
+ * colour group index, then one per tether group index. Work-item i of a launch over row r
+ * belongs to the last garment g with start[g] <= i (garments with nothing in the row have an
+ * empty range and are never picked). Garments differ in substeps, iterations, collision stride
+ * and colour-group counts: the host launches up to the largest, and a garment past its own
+ * substeps or iterations returns at once.
+ *
+ * Per substep s: drape_phase_predict, drape_phase_pins, per iteration one drape_phase_project
+ * per distance group index then per tether group index, drape_phase_collide_velocity. The
+ * arithmetic per particle is the frame kernel's (xpbd_frame.cl), in the same order. */
+
+#define DCL_ROW_PARTICLES 0u
+#define DCL_ROW_PINS 1u
+
+/* The garment owning item i of a row (i < start[count]). */
+uint dcl_owner(__global const uint* start, uint count, uint i) {
+  uint lo = 0u, hi = count;
+  while (hi - lo > 1u) {
+    const uint mid = (lo + hi) / 2u;
+    if (start[mid] <= i)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  return lo;
+}
+
+/* The first substep of the collision span holding substep s (spans of `stride` substeps, the
+ * last one ending with the frame), as the frame kernel's span0 / span counters. */
+int dcl_span_of(int s, int stride) { return s / (stride > 0 ? stride : 1); }
+
+/* The per-phase garments' counters (the others' belong to the frame kernel of the batch). */
+__kernel void drape_phase_clear_stats(__global DrapeClStats* stats, uint count,
+                                      __global const uint* work) {
+  const uint g = get_global_id(0);
+  if (g >= count || work[DCL_ROW_PARTICLES * (count + 1u) + g + 1u] ==
+                        work[DCL_ROW_PARTICLES * (count + 1u) + g])
+    return;
+  stats[g].tests = 0u;
+  stats[g].contacts = 0u;
+  stats[g].swept_catches = 0u;
+  stats[g].escapes = 0u;
+}
+
+/* Where each pinned particle starts the frame (the pins move linearly from there). */
+__kernel void drape_phase_pin_start(__global const DrapeClGarment* table, uint count,
+                                    __global const uint* work, __global const float4* x,
+                                    __global float4* pin_start, __global const uint* pin_index) {
+  const uint i = get_global_id(0);
+  __global const uint* start = work + DCL_ROW_PINS * (count + 1u);
+  if (i >= start[count]) return;
+  const uint gi = dcl_owner(start, count, i);
+  __global const DrapeClGarment* g = table + gi;
+  const uint k = g->pin_offset + (i - start[gi]);
+  pin_start[k] = x[g->particle_offset + pin_index[k]];
+}
+
+__kernel void drape_phase_predict(__global const DrapeClGarment* table, uint count,
+                                  __global const uint* work, __global float4* x,
+                                  __global float4* prev, __global float4* vel,
+                                  __global float4* span_start, int substep) {
+  const uint i = get_global_id(0);
+  __global const uint* start = work + DCL_ROW_PARTICLES * (count + 1u);
+  if (i >= start[count]) return;
+  const uint gi = dcl_owner(start, count, i);
+  __global const DrapeClGarment* g = table + gi;
+  if (substep >= g->substeps) return;
+  const int stride = g->stride;
+  const bool keep_span_start = stride > 1 && substep == dcl_span_of(substep, stride) * stride;
+  const uint p = g->particle_offset + (i - start[gi]);
+  const float4 xi = x[p];
+  if (keep_span_start) span_start[p] = xi;
+  prev[p] = xi;
+  if (xi.w == 0.0f) return;
+  float4 v = vel[p];
+  v += g->hg + g->h_drag * (g->wind - v);
+  if (g->max_speed2 > 0.0f) {
+    const float s2 = dot(v, v);
+    if (s2 > g->max_speed2) v *= g->max_speed / sqrt(s2);
+  }
+  vel[p] = v;
+  x[p] = xi + g->h * v;
+}
+
+/* Pinned particles at substep `substep` (pin_start taken by drape_phase_pin_start). */
+__kernel void drape_phase_pins(__global const DrapeClGarment* table, uint count,
+                               __global const uint* work, __global float4* x,
+                               __global const float4* pin_start, __global const uint* pin_index,
+                               __global const float4* pin_target, int substep) {
+  const uint i = get_global_id(0);
+  __global const uint* start = work + DCL_ROW_PINS * (count + 1u);
+  if (i >= start[count]) return;
+  const uint gi = dcl_owner(start, count, i);
+  __global const DrapeClGarment* g = table + gi;
+  if (substep >= g->substeps) return;
+  const uint k = g->pin_offset + (i - start[gi]);
+  const float pin_t = substep + 1 == g->substeps ? 1.0f : (float)(substep + 1) * g->inv_n;
+  const float4 a = pin_start[k];
+  const float4 b = pin_target[k];
+  const uint p = g->particle_offset + pin_index[k];
+  x[p] = (float4)(a.xyz + pin_t * (b.xyz - a.xyz), x[p].w);
+}
+
+/* Colour group `group` (distance, or tether when `tether`) of every garment that has one, in
+ * pass `iteration` of substep `substep`; `row` = its row of `work`. */
+__kernel void drape_phase_project(__global const DrapeClGarment* table, uint count,
+                                  __global const uint* work, __global float4* x,
+                                  __global const DrapeClConstraint* constraints,
+                                  __global const uint* groups, uint row, uint group, uint tether,
+                                  int substep, int iteration) {
+  const uint i = get_global_id(0);
+  __global const uint* start = work + row * (count + 1u);
+  if (i >= start[count]) return;
+  const uint gi = dcl_owner(start, count, i);
+  __global const DrapeClGarment* g = table + gi;
+  if (substep >= g->substeps || iteration >= g->iterations) return;
+  const uint first = groups[(tether ? g->tether_group_offset : g->distance_group_offset) + group];
+  const DrapeClConstraint c = constraints[first + (i - start[gi])];
+  __global float4* xs = x + g->particle_offset;
+  float4 pa = xs[c.a], pb = xs[c.b];
+  const float3 d = pa.xyz - pb.xyz;
+  const float len2 = dot(d, d);
+  if (!(len2 > 1e-18f)) return;
+  const float y = rsqrt(len2);
+  if (tether) {
+    const float c_len = fmax(len2 * y - c.rest * g->tether_scale, 0.0f);
+    pa.xyz -= (pa.w * c_len * y * c.inv_w) * d;
+    xs[c.a] = pa;
+    return;
+  }
+  const float s = (1.0f - c.rest * y) * c.inv_w;
+  pa.xyz -= (pa.w * s) * d;
+  pb.xyz += (pb.w * s) * d;
+  xs[c.a] = pa;
+  xs[c.b] = pb;
+}
+
+/* Collision against the substep's span when the span ends here, then the velocity update.
+ * Counters: one atomic per work-item that found something, into its garment's entry. */
+__kernel void drape_phase_collide_velocity(__global const DrapeClGarment* table, uint count,
+                                           __global const uint* work, __global float4* x,
+                                           __global const float4* prev, __global float4* vel,
+                                           __global const float4* span_start,
+                                           __global const uchar* masks,
+                                           __global const DrapeClShape* shapes,
+                                           __global const float4* span_bounds,
+                                           __global DrapeClStats* stats, int substep) {
+  const uint i = get_global_id(0);
+  __global const uint* start = work + DCL_ROW_PARTICLES * (count + 1u);
+  if (i >= start[count]) return;
+  const uint gi = dcl_owner(start, count, i);
+  __global const DrapeClGarment* g = table + gi;
+  if (substep >= g->substeps) return;
+  const int stride = g->stride;
+  const int span = dcl_span_of(substep, stride);
+  const bool collide = (substep + 1 - span * stride) >= stride || substep + 1 == g->substeps;
+  const uint p = g->particle_offset + (i - start[gi]);
+  float4 xi = x[p];
+  const float4 pi = prev[p];
+  CollideCounters st = {0u, 0u, 0u, 0u};
+  if (collide && g->shape_count > 0u) {
+    CollideSpan sp;
+    sp.shapes = shapes + g->shape_offset + (uint)span * g->shape_count;
+    sp.count = g->shape_count;
+    sp.flags = g->flags;
+    sp.bound_min = span_bounds[2 * (g->span_offset + (uint)span)].xyz;
+    sp.bound_max = span_bounds[2 * (g->span_offset + (uint)span) + 1].xyz;
+    sp.static_friction = g->static_friction;
+    sp.kinetic_friction = g->kinetic_friction;
+    sp.max_escape = g->max_escape;
+    const float4 from = stride > 1 ? span_start[p] : pi;
+    const uint mask = (g->flags & DRAPE_CL_GROUPED) ? (uint)masks[p] : 0xFFu;
+    const float4 y = collide_particle(&sp, mask, xi, from, &st);
+    if (any(y.xyz != xi.xyz)) {
+      xi = y;
+      x[p] = xi;
+    }
+  }
+  float4 v = (xi - pi) * g->velocity_scale;
+  if (g->max_speed2 > 0.0f) {
+    const float s2 = dot(v, v);
+    if (s2 > g->max_speed2) v *= g->max_speed / sqrt(s2);
+  }
+  vel[p] = v;
+  __global DrapeClStats* out = stats + gi;
+  if (st.tests) atomic_add(&out->tests, st.tests);
+  if (st.contacts) atomic_add(&out->contacts, st.contacts);
+  if (st.swept_catches) atomic_add(&out->swept_catches, st.swept_catches);
+  if (st.escapes) atomic_add(&out->escapes, st.escapes);
+}
