@@ -8,6 +8,10 @@
 #   bash tests/fuzz/run.sh 3600 capi        # the longer run documented in docs/robustness.md
 # Environment: DRAPE_FUZZ_JOBS (parallel jobs per target, default 1), DRAPE_FUZZ_ARGS (extra
 # libFuzzer flags).
+# The targets run side by side, each for the given wall time (on 2 cores, 30 s side by side is
+# the CPU time of 20 s one after another, in half the wall time); with DRAPE_FUZZ_JOBS > 1 or
+# DRAPE_FUZZ_SIDE_BY_SIDE=0 they run one after another (libFuzzer's -jobs logs, fuzz-<n>.log in
+# the working directory, would collide between targets).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 cd "$root"
@@ -21,36 +25,68 @@ cmake --build --preset fuzz -j"$(nproc)"
 
 build="$root/build/fuzz/tests/fuzz"
 cd "$root/build/fuzz"   # libFuzzer -jobs writes fuzz-<n>.log into the working directory
-status=0
-for t in "${targets[@]}"; do
-  corpus="$root/build/fuzz/corpus/$t"      # grows across runs (not committed)
-  artifacts="$root/build/fuzz/artifacts/$t"
+side_by_side="${DRAPE_FUZZ_SIDE_BY_SIDE:-1}"
+if ((${DRAPE_FUZZ_JOBS:-1} > 1)); then side_by_side=0; fi
+
+# Fuzzes one target; its output goes to build/fuzz/fuzz_<target>.log. Returns libFuzzer's status.
+fuzz_target() {
+  local t="$1"
+  local corpus="$root/build/fuzz/corpus/$t"      # grows across runs (not committed)
+  local artifacts="$root/build/fuzz/artifacts/$t"
   mkdir -p "$corpus" "$artifacts"
-  dirs=("$corpus" "$build/seeds/$t")
+  local dirs=("$corpus" "$build/seeds/$t")
   # Committed crash inputs (git keeps no empty folder, so it may be absent).
   if [[ -d "$root/tests/fuzz/regressions/$t" ]]; then dirs+=("$root/tests/fuzz/regressions/$t"); fi
-  echo "drape: fuzzing $t for ${seconds}s"
-  log="$root/build/fuzz/fuzz_$t.log"
+  local max_len
   case "$t" in
     obj) max_len=262144 ;;   # a MakeHuman garment is 170-230 KB
     capi) max_len=8192 ;;    # a program of up to 96 operations
     *) max_len=65536 ;;
   esac
-  jobs=()
+  local jobs=()
   if ((${DRAPE_FUZZ_JOBS:-1} > 1)); then jobs=(-jobs="$DRAPE_FUZZ_JOBS" -workers="$DRAPE_FUZZ_JOBS"); fi
   # -timeout: one input may take at most 10 s (the OBJ target dresses a 2 000-vertex garment);
   # -rss_limit_mb: the readers must not need more than 2 GB for any input.
-  if ! ASAN_OPTIONS="halt_on_error=1:detect_leaks=1:allocator_may_return_null=1" \
-       UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1" \
-       "$build/drape_fuzz_$t" "${dirs[@]}" \
-         -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len="$max_len" "${jobs[@]}" \
-         -artifact_prefix="$artifacts/" -print_final_stats=1 ${DRAPE_FUZZ_ARGS:-} >"$log" 2>&1; then
-    echo "drape: fuzz_$t FAILED; the last lines of $log:" >&2
+  ASAN_OPTIONS="halt_on_error=1:detect_leaks=1:allocator_may_return_null=1" \
+  UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1" \
+    "$build/drape_fuzz_$t" "${dirs[@]}" \
+      -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len="$max_len" "${jobs[@]}" \
+      -artifact_prefix="$artifacts/" -print_final_stats=1 ${DRAPE_FUZZ_ARGS:-} \
+      >"$root/build/fuzz/fuzz_$t.log" 2>&1
+}
+
+# Reports one finished target: its statistics, or the end of its log when it failed.
+report_target() {
+  local t="$1" rc="$2" log="$root/build/fuzz/fuzz_$1.log"
+  if ((rc != 0)); then
+    echo "drape: fuzz_$t FAILED (exit $rc); the last lines of $log:" >&2
     tail -40 "$log" >&2
-    status=1
-  else
-    grep -E '^(stat::number_of_executed_units|stat::new_units_added|stat::peak_rss_mb)' "$log" | tr '\n' ' '
-    echo
+    return 1
   fi
-done
+  echo -n "drape: fuzz_$t: "
+  grep -E '^(stat::number_of_executed_units|stat::new_units_added|stat::peak_rss_mb)' "$log" | tr '\n' ' '
+  echo
+}
+
+status=0
+if ((side_by_side)); then
+  echo "drape: fuzzing ${targets[*]} side by side, ${seconds}s each"
+  declare -A pids=()
+  for t in "${targets[@]}"; do
+    fuzz_target "$t" &
+    pids[$t]=$!
+  done
+  for t in "${targets[@]}"; do
+    rc=0
+    wait "${pids[$t]}" || rc=$?
+    report_target "$t" "$rc" || status=1
+  done
+else
+  for t in "${targets[@]}"; do
+    echo "drape: fuzzing $t for ${seconds}s"
+    rc=0
+    fuzz_target "$t" || rc=$?
+    report_target "$t" "$rc" || status=1
+  done
+fi
 exit $status
