@@ -9,9 +9,12 @@
 #include "proxies/mesh_bvh.h"
 #include "test_data.h"
 
+#include "sanitizer_scale.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <iterator>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -270,8 +273,11 @@ void expectSane(const ObjMesh& m, const GarmentMesh& g) {
                                    tp, topo, err)) << err;
 }
 
+// Under the sanitizers the first suit only (tests/native/sanitizer_scale.h).
+constexpr int kSuitsToFit = test::repeatsUnderSanitizers(static_cast<int>(std::size(kSuits)), 100);
+
 TEST(GarmentObjFit, SuitsSitOnLightDefaultAndHeavyBodies) {
-  for (const Suit& s : kSuits) {
+  for (const Suit& s : std::vector<Suit>(kSuits, kSuits + kSuitsToFit)) {
     LOAD_SUIT(m, s.file);
     std::string err;
     std::vector<Vec3> placed;
@@ -297,7 +303,7 @@ TEST(GarmentObjFit, SuitsSitOnLightDefaultAndHeavyBodies) {
 
 TEST(GarmentObjFit, RetargetingBeatsPlainPlacementOnHeavyBody) {
   const Body& heavy = heavyBody();
-  for (const Suit& s : kSuits) {
+  for (const Suit& s : std::vector<Suit>(kSuits, kSuits + kSuitsToFit)) {
     LOAD_SUIT(m, s.file);
     std::string err;
     const ObjFitParams p = paramsFor(s);
