@@ -71,12 +71,10 @@ __kernel void drape_collide(__global const DrapeClGarment* g, __global float4* x
   if (st.escapes) atomic_add(&stats->escapes, st.escapes);
 }
 
-/* One constraint colour group (tests): constraints [begin, end), one work-item each. */
-__kernel void drape_project_group(__global float4* x, __global const DrapeClConstraint* constraints,
-                                  uint begin, uint end, uint tether, float tether_scale) {
-  const uint k = begin + get_global_id(0);
-  if (k >= end) return;
-  const DrapeClConstraint c = constraints[k];
+/* One distance constraint (both ends move) or tether (one-sided: only a moves, and only when
+ * stretched past rest * tether_scale) projected in place in x: the Gauss-Seidel step of the
+ * per-phase path (drape_phase_project, phases.cl) and of the per-kernel stage below. */
+inline void dcl_project_one(__global float4* x, const DrapeClConstraint c, uint tether, float tether_scale) {
   float4 pa = x[c.a], pb = x[c.b];
   const float3 d = pa.xyz - pb.xyz;
   const float len2 = dot(d, d);
@@ -93,6 +91,14 @@ __kernel void drape_project_group(__global float4* x, __global const DrapeClCons
   pb.xyz += (pb.w * s) * d;
   x[c.a] = pa;
   x[c.b] = pb;
+}
+
+/* One constraint colour group (tests): constraints [begin, end), one work-item each. */
+__kernel void drape_project_group(__global float4* x, __global const DrapeClConstraint* constraints,
+                                  uint begin, uint end, uint tether, float tether_scale) {
+  const uint k = begin + get_global_id(0);
+  if (k >= end) return;
+  dcl_project_one(x, constraints[k], tether, tether_scale);
 }
 
 /* Area-weighted unit vertex normals (vertexNormals in body/mesh_metrics.cpp) without atomics:

@@ -121,24 +121,7 @@ __kernel void drape_phase_project(__global const DrapeClGarment* table, uint cou
   __global const DrapeClGarment* g = table + gi;
   if (substep >= g->substeps || iteration >= g->iterations) return;
   const uint first = groups[(tether ? g->tether_group_offset : g->distance_group_offset) + group];
-  const DrapeClConstraint c = constraints[first + (i - start[gi])];
-  __global float4* xs = x + g->particle_offset;
-  float4 pa = xs[c.a], pb = xs[c.b];
-  const float3 d = pa.xyz - pb.xyz;
-  const float len2 = dot(d, d);
-  if (!(len2 > 1e-18f)) return;
-  const float y = rsqrt(len2);
-  if (tether) {
-    const float c_len = fmax(len2 * y - c.rest * g->tether_scale, 0.0f);
-    pa.xyz -= (pa.w * c_len * y * c.inv_w) * d;
-    xs[c.a] = pa;
-    return;
-  }
-  const float s = (1.0f - c.rest * y) * c.inv_w;
-  pa.xyz -= (pa.w * s) * d;
-  pb.xyz += (pb.w * s) * d;
-  xs[c.a] = pa;
-  xs[c.b] = pb;
+  dcl_project_one(x + g->particle_offset, constraints[first + (i - start[gi])], tether, g->tether_scale);
 }
 
 /* Collision against the substep's span when the span ends here, then the velocity update.
