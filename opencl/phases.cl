@@ -31,6 +31,17 @@ uint dcl_owner(__global const uint* start, uint count, uint i) {
   return lo;
 }
 
+/* This work-item's item of row `row` of `work`: its garment `*gi` and its index `*j` among that
+ * garment's items. False for the work-items past the row's last item (launches are rounded up). */
+bool dcl_item(__global const uint* work, uint count, uint row, uint* gi, uint* j) {
+  const uint i = get_global_id(0);
+  __global const uint* start = work + row * (count + 1u);
+  if (i >= start[count]) return false;
+  *gi = dcl_owner(start, count, i);
+  *j = i - start[*gi];
+  return true;
+}
+
 /* The first substep of the collision span holding substep s (spans of `stride` substeps, the
  * last one ending with the frame), as the frame kernel's span0 / span counters. */
 int dcl_span_of(int s, int stride) { return s / (stride > 0 ? stride : 1); }
@@ -52,12 +63,10 @@ __kernel void drape_phase_clear_stats(__global DrapeClStats* stats, uint count,
 __kernel void drape_phase_pin_start(__global const DrapeClGarment* table, uint count,
                                     __global const uint* work, __global const float4* x,
                                     __global float4* pin_start, __global const uint* pin_index) {
-  const uint i = get_global_id(0);
-  __global const uint* start = work + DCL_ROW_PINS * (count + 1u);
-  if (i >= start[count]) return;
-  const uint gi = dcl_owner(start, count, i);
+  uint gi, j;
+  if (!dcl_item(work, count, DCL_ROW_PINS, &gi, &j)) return;
   __global const DrapeClGarment* g = table + gi;
-  const uint k = g->pin_offset + (i - start[gi]);
+  const uint k = g->pin_offset + j;
   pin_start[k] = x[g->particle_offset + pin_index[k]];
 }
 
@@ -65,15 +74,13 @@ __kernel void drape_phase_predict(__global const DrapeClGarment* table, uint cou
                                   __global const uint* work, __global float4* x,
                                   __global float4* prev, __global float4* vel,
                                   __global float4* span_start, int substep) {
-  const uint i = get_global_id(0);
-  __global const uint* start = work + DCL_ROW_PARTICLES * (count + 1u);
-  if (i >= start[count]) return;
-  const uint gi = dcl_owner(start, count, i);
+  uint gi, j;
+  if (!dcl_item(work, count, DCL_ROW_PARTICLES, &gi, &j)) return;
   __global const DrapeClGarment* g = table + gi;
   if (substep >= g->substeps) return;
   const int stride = g->stride;
   const bool keep_span_start = stride > 1 && substep == dcl_span_of(substep, stride) * stride;
-  const uint p = g->particle_offset + (i - start[gi]);
+  const uint p = g->particle_offset + j;
   const float4 xi = x[p];
   if (keep_span_start) span_start[p] = xi;
   prev[p] = xi;
@@ -93,13 +100,11 @@ __kernel void drape_phase_pins(__global const DrapeClGarment* table, uint count,
                                __global const uint* work, __global float4* x,
                                __global const float4* pin_start, __global const uint* pin_index,
                                __global const float4* pin_target, int substep) {
-  const uint i = get_global_id(0);
-  __global const uint* start = work + DCL_ROW_PINS * (count + 1u);
-  if (i >= start[count]) return;
-  const uint gi = dcl_owner(start, count, i);
+  uint gi, j;
+  if (!dcl_item(work, count, DCL_ROW_PINS, &gi, &j)) return;
   __global const DrapeClGarment* g = table + gi;
   if (substep >= g->substeps) return;
-  const uint k = g->pin_offset + (i - start[gi]);
+  const uint k = g->pin_offset + j;
   const float pin_t = substep + 1 == g->substeps ? 1.0f : (float)(substep + 1) * g->inv_n;
   const float4 a = pin_start[k];
   const float4 b = pin_target[k];
@@ -114,14 +119,12 @@ __kernel void drape_phase_project(__global const DrapeClGarment* table, uint cou
                                   __global const DrapeClConstraint* constraints,
                                   __global const uint* groups, uint row, uint group, uint tether,
                                   int substep, int iteration) {
-  const uint i = get_global_id(0);
-  __global const uint* start = work + row * (count + 1u);
-  if (i >= start[count]) return;
-  const uint gi = dcl_owner(start, count, i);
+  uint gi, j;
+  if (!dcl_item(work, count, row, &gi, &j)) return;
   __global const DrapeClGarment* g = table + gi;
   if (substep >= g->substeps || iteration >= g->iterations) return;
   const uint first = groups[(tether ? g->tether_group_offset : g->distance_group_offset) + group];
-  dcl_project_one(x + g->particle_offset, constraints[first + (i - start[gi])], tether, g->tether_scale);
+  dcl_project_one(x + g->particle_offset, constraints[first + j], tether, g->tether_scale);
 }
 
 /* Collision against the substep's span when the span ends here, then the velocity update.
@@ -134,16 +137,14 @@ __kernel void drape_phase_collide_velocity(__global const DrapeClGarment* table,
                                            __global const DrapeClShape* shapes,
                                            __global const float4* span_bounds,
                                            __global DrapeClStats* stats, int substep) {
-  const uint i = get_global_id(0);
-  __global const uint* start = work + DCL_ROW_PARTICLES * (count + 1u);
-  if (i >= start[count]) return;
-  const uint gi = dcl_owner(start, count, i);
+  uint gi, j;
+  if (!dcl_item(work, count, DCL_ROW_PARTICLES, &gi, &j)) return;
   __global const DrapeClGarment* g = table + gi;
   if (substep >= g->substeps) return;
   const int stride = g->stride;
   const int span = dcl_span_of(substep, stride);
   const bool collide = (substep + 1 - span * stride) >= stride || substep + 1 == g->substeps;
-  const uint p = g->particle_offset + (i - start[gi]);
+  const uint p = g->particle_offset + j;
   float4 xi = x[p];
   const float4 pi = prev[p];
   CollideCounters st = {0u, 0u, 0u, 0u};

@@ -38,6 +38,16 @@ std::string lastError() {
   return m ? std::string(m) : std::string("<drape_last_error returned NULL>");
 }
 
+// The context's backend (drape_context_get_backend_info), the struct filled with 0xAB first so a
+// field the call leaves unwritten shows.
+drape_backend_info backendInfo(drape_context* ctx) {
+  drape_backend_info i;
+  std::memset(&i, 0xAB, sizeof(i));
+  i.struct_size = sizeof(i);
+  EXPECT_EQ(drape_context_get_backend_info(ctx, &i), DRAPE_OK) << lastError();
+  return i;
+}
+
 // `call` must fail with `code` and leave a fresh, non-empty message. When `fn` is non-null the
 // message must also name that function.
 ::testing::AssertionResult failsWith(drape_result code, const char* fn, const std::function<drape_result()>& call,

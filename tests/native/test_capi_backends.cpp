@@ -29,14 +29,6 @@ drape_result pushAndStep(drape_context* ctx, int i, float dx = 0.0f) {
   return drape_context_step(ctx, 1.0f / 30.0f);
 }
 
-drape_backend_info info(drape_context* ctx) {
-  drape_backend_info i;
-  std::memset(&i, 0xAB, sizeof(i));
-  i.struct_size = sizeof(i);
-  EXPECT_EQ(drape_context_get_backend_info(ctx, &i), DRAPE_OK) << lastError();
-  return i;
-}
-
 TEST(CApiBackends, DescDefaults) {
   drape_backend_desc d;
   std::memset(&d, 0xFF, sizeof(d));
@@ -54,7 +46,7 @@ TEST(CApiBackends, DescDefaults) {
 
 TEST(CApiBackends, NewContextRunsOnTheCpu) {
   ContextPtr ctx = makeContext();
-  const drape_backend_info i = info(ctx.get());
+  const drape_backend_info i = backendInfo(ctx.get());
   EXPECT_EQ(i.struct_size, sizeof(drape_backend_info));
   EXPECT_EQ(i.requested, DRAPE_BACKEND_CPU);
   EXPECT_EQ(i.active, DRAPE_BACKEND_CPU);
@@ -77,7 +69,7 @@ TEST(CApiBackends, BadArgumentsAreRejectedAndChangeNothing) {
     b.backend = DRAPE_BACKEND_OPENCL;  // a valid request spoilt by one field
     change(b);
     EXPECT_FAILS(code, fn, drape_context_set_backend(ctx.get(), &b));
-    EXPECT_EQ(info(ctx.get()).requested, DRAPE_BACKEND_CPU);  // nothing changed
+    EXPECT_EQ(backendInfo(ctx.get()).requested, DRAPE_BACKEND_CPU);  // nothing changed
   };
   bad(DRAPE_ERROR_INVALID_ARGUMENT, [](drape_backend_desc& b) { b.struct_size = 8; });
   bad(DRAPE_ERROR_OUT_OF_RANGE, [](drape_backend_desc& b) { b.backend = 3; });
@@ -114,7 +106,7 @@ TEST(CApiBackends, ImpossibleDeviceFallsBackWithTheReason) {
   d.backend = DRAPE_BACKEND_OPENCL;
   d.platform_index = 200;  // no machine has 201 OpenCL platforms
   ASSERT_OK(drape_context_set_backend(ctx.get(), &d));
-  const drape_backend_info i = info(ctx.get());
+  const drape_backend_info i = backendInfo(ctx.get());
   EXPECT_EQ(i.requested, DRAPE_BACKEND_OPENCL);
   EXPECT_EQ(i.active, DRAPE_BACKEND_CPU);
   EXPECT_EQ(i.cpu_garments, 1u);
@@ -158,7 +150,7 @@ TEST(CApiBackends, GarmentStepsOnOpenClWhenADeviceExists) {
   ASSERT_OK(drape_backend_desc_init(&d));
   d.backend = DRAPE_BACKEND_OPENCL;
   ASSERT_OK(drape_context_set_backend(ctx.get(), &d));
-  const drape_backend_info i = info(ctx.get());
+  const drape_backend_info i = backendInfo(ctx.get());
   if (i.active != DRAPE_BACKEND_OPENCL) GTEST_SKIP() << "OpenCL device unusable: " << i.fallback_reason;
   EXPECT_EQ(i.opencl_garments, 1u);
   EXPECT_NE(i.device_name[0], '\0');
@@ -176,12 +168,12 @@ TEST(CApiBackends, GarmentStepsOnOpenClWhenADeviceExists) {
   // A second garment added later lands on the device too; AUTO with a high threshold moves both back.
   drape_garment* g2 = addSmallTShirt(ctx.get());
   ASSERT_NE(g2, nullptr);
-  EXPECT_EQ(info(ctx.get()).opencl_garments, 2u);
+  EXPECT_EQ(backendInfo(ctx.get()).opencl_garments, 2u);
   d.backend = DRAPE_BACKEND_AUTO;
   d.opencl_min_particles = 100000;
   ASSERT_OK(drape_context_set_backend(ctx.get(), &d));
-  EXPECT_EQ(info(ctx.get()).opencl_garments, 0u);
-  EXPECT_EQ(info(ctx.get()).active, DRAPE_BACKEND_CPU);
+  EXPECT_EQ(backendInfo(ctx.get()).opencl_garments, 0u);
+  EXPECT_EQ(backendInfo(ctx.get()).active, DRAPE_BACKEND_CPU);
   ASSERT_OK(pushAndStep(ctx.get(), 6));
 }
 

@@ -79,14 +79,6 @@ World makeWorld(const std::vector<uint32_t>& particles, drape_backend backend, u
   return w;
 }
 
-drape_backend_info backendInfo(drape_context* ctx) {
-  drape_backend_info i;
-  std::memset(&i, 0, sizeof(i));
-  i.struct_size = sizeof(i);
-  EXPECT_EQ(drape_context_get_backend_info(ctx, &i), DRAPE_OK) << lastError();
-  return i;
-}
-
 drape_result push(World& w, const Take& take, size_t f) {
   const drape_skeleton_frame fr = makeFrame(take.layout, take.joints[f], take.t[f]);
   return drape_context_push_skeleton(w.ctx.get(), &fr);

@@ -426,7 +426,8 @@ drape_result Context::stepContexts(Context* const* contexts, size_t count, float
   if (count == 1) {
     if (begun == 1) runStagedFrames(contexts[0]->stepping_);  // drape_context_step: no gathering
   } else {
-    std::vector<GarmentSim*> staged;
+    std::vector<GarmentSim*>& staged = contexts[0]->gathered_;  // scratch kept between steps
+    staged.clear();
     for (size_t i = 0; i < begun; ++i)
       staged.insert(staged.end(), contexts[i]->stepping_.begin(), contexts[i]->stepping_.end());
     runStagedFrames(staged);

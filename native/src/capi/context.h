@@ -125,6 +125,7 @@ class Context {
   void endStep();
   static void runStagedFrames(const std::vector<GarmentSim*>& garments);
   std::vector<GarmentSim*> stepping_;  // begun, not yet ended
+  std::vector<GarmentSim*> gathered_;  // stepContexts: the staged garments of every context
   float stepDt_ = 0.0f;
   size_t stepSlept_ = 0;
   std::chrono::steady_clock::time_point stepT0_{};

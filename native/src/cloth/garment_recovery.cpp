@@ -94,25 +94,23 @@ bool GarmentSim::restoreState(KeptState& k, const BodyModel& body, const RingPos
   // Sweep from the kept pose to this one. The reachable set of ellipsoids may have changed since
   // (proxy culling): then the kept ellipsoids do not pair with the current ones and the garment
   // settles on the current pose instead.
+  // The kept ellipsoids and attachment targets carried to the current pelvis (world), once.
   const bool sweep = k.ellipsoids.size() == end.size();
+  catch_kept_.resize(sweep ? end.size() : 0);
+  for (size_t i = 0; i < catch_kept_.size(); ++i) catch_kept_[i] = fromFrame(k.ellipsoids[i], pelvis.frame, pelvis.centre);
+  catch_kept_pins_.resize(pins_.size());
+  for (size_t i = 0; i < pins_.size(); ++i) catch_kept_pins_[i] = pelvis.frame * k.pins[i] + pelvis.centre;
   catch_a_.resize(end.size());
   catch_b_.resize(end.size());
   catch_pins_.resize(pins_.size());
   for (int f = 0; f < kCatchUpFrames; ++f) {
     const float t0 = static_cast<float>(f) / kCatchUpFrames, t1 = static_cast<float>(f + 1) / kCatchUpFrames;
     for (size_t i = 0; i < end.size(); ++i) {
-      if (!sweep) {
-        catch_a_[i] = catch_b_[i] = end[i];
-        continue;
-      }
-      const Ellipsoid kept = fromFrame(k.ellipsoids[i], pelvis.frame, pelvis.centre);
-      catch_a_[i] = interpolateEllipsoid(kept, end[i], t0);
-      catch_b_[i] = interpolateEllipsoid(kept, end[i], t1);
+      catch_a_[i] = sweep ? interpolateEllipsoid(catch_kept_[i], end[i], t0) : end[i];
+      catch_b_[i] = sweep ? interpolateEllipsoid(catch_kept_[i], end[i], t1) : end[i];
     }
-    for (size_t i = 0; i < pins_.size(); ++i) {
-      const Vec3 kept = pelvis.frame * k.pins[i] + pelvis.centre;
-      catch_pins_[i] = kept + t1 * (pins_[i] - kept);
-    }
+    for (size_t i = 0; i < pins_.size(); ++i)
+      catch_pins_[i] = catch_kept_pins_[i] + t1 * (pins_[i] - catch_kept_pins_[i]);
     runFrame(catch_a_, catch_b_, catch_pins_, kCatchUpFrameS);
   }
   last_.blend_frames = kCatchUpFrames;

@@ -236,8 +236,8 @@ class GarmentSim {
   float tracking_noise_m_ = 0.0f;
   double sim_time_s_ = 0.0;  // the dt of every step so far
   uint32_t jump_restores_ = 0, burst_restores_ = 0;
-  std::vector<Ellipsoid> catch_a_, catch_b_;  // restoreState scratch
-  std::vector<Vec3> catch_pins_;
+  std::vector<Ellipsoid> catch_kept_, catch_a_, catch_b_;  // restoreState scratch
+  std::vector<Vec3> catch_kept_pins_, catch_pins_;
 
   GarmentMesh mesh_;
   GarmentTopology topology_;

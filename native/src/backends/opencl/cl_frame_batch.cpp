@@ -273,10 +273,7 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
       const auto from = x_host_.begin() + static_cast<long>(particles + size_t{table_[i].particle_offset});
       s.normals_.assign(from, from + static_cast<long>(s.particleCount()));
     }
-    s.collision_stats_.tests = stats_host_[i].tests;
-    s.collision_stats_.contacts = stats_host_[i].contacts;
-    s.collision_stats_.swept_catches = stats_host_[i].swept_catches;
-    s.collision_stats_.escapes = stats_host_[i].escapes;
+    s.collision_stats_ = toCollisionStats(stats_host_[i]);
   }
   return true;
 }

@@ -171,7 +171,10 @@ bool ClXpbdSolver::runPreparedFrame() {
     device_error_ = std::string("OpenCL shape buffer failed (") + clErrorName(rc) + ")";
     return false;
   }
-  std::vector<cl_event> writes, runs, reads;
+  // Events and readback in scratch kept between frames: no allocation per frame.
+  std::vector<cl_event>& writes = writes_;
+  std::vector<cl_event>& runs = runs_;
+  std::vector<cl_event>& reads = reads_;
   const auto wall0 = Clock::now();
   bool ok = upload(garment_, &g, sizeof(g), &writes) &&
             upload(pin_target_buf_, pin_target4_.data(), pin_target4_.size() * 16, &writes) &&
@@ -200,7 +203,7 @@ bool ClXpbdSolver::runPreparedFrame() {
   // Positions, and after them the normals when the frame computed them: one readback.
   const size_t rows = normals_frame_ ? 2 * n : n;
   DrapeClStats stats{};
-  std::vector<Eigen::Vector4f> x_back;
+  std::vector<Eigen::Vector4f>& x_back = readback_;
   if (ok) {
     x_back.resize(rows);
     cl_event e1 = nullptr, e2 = nullptr;
@@ -238,15 +241,11 @@ bool ClXpbdSolver::runPreparedFrame() {
   }
   if (normals_frame_) {
     normals_.assign(x_back.begin() + static_cast<long>(n), x_back.end());
-    x_back.resize(n);
     normals_valid_ = true;
   }
-  x_.swap(x_back);
+  std::copy(x_back.begin(), x_back.begin() + static_cast<long>(n), x_.begin());
   v_stale_ = true;
-  collision_stats_.tests = stats.tests;
-  collision_stats_.contacts = stats.contacts;
-  collision_stats_.swept_catches = stats.swept_catches;
-  collision_stats_.escapes = stats.escapes;
+  collision_stats_ = toCollisionStats(stats);
   return true;
 }
 

@@ -20,6 +20,16 @@
 
 namespace drape {
 
+// A frame's collision counters as the device left them (DrapeClStats), in the CPU's form.
+inline CollisionStats toCollisionStats(const DrapeClStats& s) {
+  CollisionStats c;
+  c.tests = s.tests;
+  c.contacts = s.contacts;
+  c.swept_catches = s.swept_catches;
+  c.escapes = s.escapes;
+  return c;
+}
+
 // Per-frame split of the last step (device profiling when the queue has it, else wall clock).
 struct ClStepTimings {
   double upload_ns = 0.0;    // host -> device writes (shapes, pins, the garment record)
@@ -118,6 +128,8 @@ class ClXpbdSolver {
   bool constraints_dirty_ = true;
 
   std::vector<Eigen::Vector4f> x_;
+  std::vector<cl_event> writes_, runs_, reads_;   // stepDevice scratch (events of one frame)
+  std::vector<Eigen::Vector4f> readback_;        // stepDevice scratch (positions, then normals)
   mutable std::vector<Eigen::Vector4f> v_;
   mutable bool v_stale_ = false;
   std::vector<Vec3> pin_target_;
