@@ -180,6 +180,31 @@ TEST(OpenClBackend, ImpossibleDeviceFallsBackToCpuWithReason) {
   EXPECT_GT(g->lastStep().substeps, 0);
 }
 
+TEST(OpenClBackend, AGarmentRefittedToANewBodyShapeStaysOnTheDevice) {
+  DRAPE_REQUIRE_OPENCL(rt);
+  Context ctx(test::defaultDesc());
+  std::string err;
+  GarmentSim* g = test::addTemplate(ctx, GarmentKind::TShirt, 300, ClothSolverKind::Xpbd, GarmentSimParams{}, err);
+  ASSERT_NE(g, nullptr) << err;
+  drape_backend_desc d;
+  drape_backend_desc_init(&d);
+  d.backend = DRAPE_BACKEND_OPENCL;
+  ASSERT_EQ(ctx.setBackend(d, err), DRAPE_OK);
+  ASSERT_EQ(g->backend(), GarmentBackend::OpenCl);
+  for (int f = 0; f < 5; ++f) stepPose(ctx, restPose(ctx.shape()), f / 30.0, 1.0f / 30.0f);
+  BodyShapeInput tall;
+  tall.height_m = 2.0f;
+  tall.weight_kg = 110.0f;
+  ASSERT_EQ(ctx.setShape(tall, err), DRAPE_OK) << err;
+  // The refit builds a CPU solver; the context moves it back to the device it was on.
+  EXPECT_EQ(g->backend(), GarmentBackend::OpenCl);
+  for (int f = 5; f < 20; ++f) stepPose(ctx, restPose(ctx.shape()), f / 30.0, 1.0f / 30.0f);
+  EXPECT_FALSE(g->deviceFailed(nullptr));
+  const GarmentAccuracy a = g->measure(ctx.proxies().ellipsoids(), nullptr);
+  EXPECT_LT(a.stretch.p99, 0.3f);
+  for (size_t i = 0; i < g->particleCount(); ++i) ASSERT_TRUE(g->positions()[i].allFinite());
+}
+
 TEST(OpenClBackend, AutoKeepsSmallGarmentsOnTheCpu) {
   DRAPE_REQUIRE_OPENCL(rt);
   Context ctx(test::defaultDesc());

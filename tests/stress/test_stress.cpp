@@ -293,9 +293,11 @@ TEST(StressBodyShape, ShapeChangedUnderTheGarment) {
   }
   print("shape changed every 40 frames", scene.series);
   expectHealthy(scene.series, "shape changes");
-  // The garment keeps the cut of the body it was added to: a 1.0 m / BMI 15 body put under a shirt
-  // cut for 1.70 m / 65 kg and then a 2.2 m / BMI 45 one stretch it hard (measured worst 290 %).
-  EXPECT_LE(scene.series.maxP99(0, 1e9), 4.0f);
+  // Each change refits the garment to the new body (drape_context_set_body_shape): measured worst
+  // P99 0.50 at 1 000 particles, 0.52 at 2 000, in the frames that blend the refitted garment in
+  // on bodies from 1.0 m / BMI 15 to 2.2 m / BMI 45. Keeping the cut of the 1.70 m / 65 kg body it
+  // was added to, the shirt reached 2.9 and 4.3.
+  EXPECT_LE(scene.series.maxP99(0, 1e9), 0.8f);
 }
 
 // ---------------------------------------------------------------------------------------------

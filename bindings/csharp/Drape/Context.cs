@@ -85,7 +85,10 @@ namespace Drape
         // ---- Body shape --------------------------------------------------------------------------
 
         /// <summary>Sets the body shape (drape_context_set_body_shape); start from
-        /// <see cref="BodyShape.CreateDefault"/>. On failure the previous shape is kept.</summary>
+        /// <see cref="BodyShape.CreateDefault"/>. Garments already added are refitted to the new
+        /// body: same vertices and triangles, cut carried to the new body and dressed there (tens of
+        /// milliseconds per garment); the same measurements again change nothing. On failure the
+        /// previous shape and garments are kept.</summary>
         public void SetBodyShape(in BodyShape shape)
         {
             IntPtr h = Live;

@@ -186,7 +186,7 @@ namespace Drape
         /// <see cref="VertexCount"/> float4 = 4 * VertexCount floats, (x, y, z) in metres and w the
         /// inverse mass (0 for particles attached to the body).
         /// <para><b>The span points into the library's memory and is valid only until the next
-        /// <see cref="Context.Step"/>, <see cref="Params"/> set, <see cref="Dispose"/> or
+        /// <see cref="Context.Step"/>, <see cref="Context.SetBodyShape"/>, <see cref="Params"/> set, <see cref="Dispose"/> or
         /// <see cref="Drape.Context.Dispose"/>.</b> Reading it after any of these reads freed or
         /// stale memory (the runtime cannot detect it). Do not keep it across frames: call
         /// ViewPositions again after each Step. Read-only: writing through it (via unsafe casts) is

@@ -199,7 +199,12 @@ typedef struct drape_body_shape {
 DRAPE_API drape_result DRAPE_CALL drape_body_shape_init(drape_body_shape* shape);
 
 /* Sets the body shape. The mesh topology does not change; the next update rebuilds the rings.
- * On failure the previous shape is kept. Thread-safety: one thread per context. */
+ * Garments already added are refitted to the new body: each keeps its vertices, triangles,
+ * attachments and parameters, its cut is carried to the new body and dressed there (as a new
+ * garment is, tens of milliseconds per garment), and the next drape_context_step places it on the
+ * tracked person. Setting the same measurements again changes nothing. On failure (a bad value,
+ * or a garment that cannot be dressed on the new body) the previous shape and garments are kept.
+ * Thread-safety: one thread per context. */
 DRAPE_API drape_result DRAPE_CALL drape_context_set_body_shape(drape_context* context,
                                                                const drape_body_shape* shape);
 
@@ -545,8 +550,8 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_read_rest_positions(drape_garmen
 
 /* Borrowed view of the particle positions, no copy: *out_xyzw points at vertex_count float4
  * (x, y, z in metres, w = inverse mass, 0 for attached particles), owned by the library and valid
- * until the next drape_context_step, drape_garment_set_params, drape_garment_destroy or
- * drape_context_destroy. Read-only. */
+ * until the next drape_context_step, drape_context_set_body_shape, drape_garment_set_params,
+ * drape_garment_destroy or drape_context_destroy. Read-only. */
 DRAPE_API drape_result DRAPE_CALL drape_garment_view_positions(drape_garment* garment,
                                                                const float** out_xyzw,
                                                                uint32_t* out_vertex_count);

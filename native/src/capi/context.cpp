@@ -106,9 +106,37 @@ drape_result Context::setShape(const BodyShapeInput& in, std::string& err) {
   bool nonfinite = false;
   if (!validateShapeInput(in, err, &nonfinite))
     return nonfinite ? DRAPE_ERROR_NONFINITE : DRAPE_ERROR_OUT_OF_RANGE;
+  const ResolvedShape before = shape_;
   shape_ = resolveShape(in);
   body_->setShape(shape_);
   restBody_.reset();
+  // Garments are refitted to the new body (GarmentSim::refitted, docs/garments.md "Body shape
+  // changes"): all of them or, when one cannot be dressed on it, none and the old shape back.
+  std::vector<std::unique_ptr<GarmentSim>> refits;
+  // The same measurements again (a host that sets the shape every frame) change nothing.
+  const size_t refit_count = before.m == shape_.m ? 0 : garments_.size();
+  refits.reserve(refit_count);
+  for (size_t i = 0; i < refit_count; ++i) {
+    std::string why;
+    refits.push_back(garments_[i]->refitted(restBody(), restEllipsoids(), restEllipsoidChains(), why));
+    if (!refits.back()) {
+      shape_ = before;
+      body_->setShape(shape_);
+      restBody_.reset();
+      err = "garment " + std::to_string(i) + " could not be dressed on the new body (" + why +
+            "); the previous shape is kept";
+      return DRAPE_ERROR_INVALID_ARGUMENT;
+    }
+  }
+  ReachParams rp;
+  rp.margin_m = options_.reach_margin_m;
+  for (size_t i = 0; i < refit_count; ++i) {
+    GarmentSim& g = *garments_[i];
+    g.replaceWith(std::move(*refits[i]));
+    adaptive_.removeGarment(&g);
+    adaptive_.addGarment(&g, garmentReach(g, rp));
+    applyBackend(g);
+  }
   shapeDirty_ = true;
   volumeDirty_ = true;
   // The body changes under sleeping garments, and the ellipsoids' bounds with the rest body.

@@ -128,6 +128,7 @@ std::vector<float> flatten(const std::vector<Vec3>& v) {
 }  // namespace
 
 GarmentSim::~GarmentSim() = default;
+GarmentSim& GarmentSim::operator=(GarmentSim&&) noexcept = default;
 
 std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const TopologyParams& topo,
                                                ClothSolverKind solver, const GarmentSimParams& params,
@@ -195,6 +196,15 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
   g->seen_pelvis_c_ = pr.centre;
   g->seen_pelvis_f_ = pr.frame;
   g->pinTargets(body_rest, g->seen_pins_);
+
+  {
+    auto origin = std::make_shared<Origin>();
+    origin->mesh = mesh;
+    origin->topology = topo;
+    origin->dress_time_s = dress_time_s;
+    origin->skin.bind(body_rest, mesh.positions, kSkinBlendM);
+    g->origin_ = std::move(origin);
+  }
 
   // Dressing. A garment that starts partly inside the body (an OBJ fitted from another body) is
   // not pushed out in one go, which would tear it where neighbours leave on different sides:
@@ -265,6 +275,38 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
   g->skin_.bind(body_rest, g->dressed_, kSkinBlendM);
   g->last_ = GarmentStepStats{};
   return g;
+}
+
+std::unique_ptr<GarmentSim> GarmentSim::refitted(const BodyModel& body_rest,
+                                                 const std::vector<Ellipsoid>& rest_ellipsoids,
+                                                 const std::vector<int>& ellipsoid_chains,
+                                                 std::string& err) const {
+  const Origin& o = *origin_;
+  GarmentMesh mesh = o.mesh;
+  o.skin.place(body_rest, mesh.positions);
+  // Attachments keep their ring; their offset from it follows the carried cut (the ring grew or
+  // shrank with the body, so the old offset in metres would put the pin inside or off the body).
+  for (size_t k = 0; k < mesh.pinned.size(); ++k) {
+    const RingPose& r = body_rest.rings()[static_cast<size_t>(mesh.pin_ring[k])];
+    mesh.pin_local[k] = r.frame.transpose() * (mesh.positions[mesh.pinned[k]] - r.centre);
+  }
+  std::unique_ptr<GarmentSim> g = create(mesh, o.topology, kind_, params_, o.dress_time_s, body_rest,
+                                         rest_ellipsoids, ellipsoid_chains, err, true);
+  if (g) g->origin_ = origin_;
+  return g;
+}
+
+void GarmentSim::replaceWith(GarmentSim&& fresh) {
+  void* const token = api_token;
+  void* const owner = api_owner;
+  const uint64_t steps = steps_;
+  const uint32_t jumps = jump_restores_, bursts = burst_restores_;
+  *this = std::move(fresh);
+  api_token = token;
+  api_owner = owner;
+  steps_ = steps;
+  jump_restores_ = jumps;
+  burst_restores_ = bursts;
 }
 
 uint8_t GarmentSim::maskForChain(int chain) {

@@ -103,6 +103,22 @@ class GarmentSim {
                                             std::string& err, bool cut_from_dressed = false);
   ~GarmentSim();
 
+  // Refitting to a new body shape (the host changed the person's height, weight or girths while
+  // the garment is worn): a new garment like this one, its cut carried to the body `body_rest` (the
+  // context's new rest body, same ring layout) by ring skinning, then dressed there as create()
+  // dresses with cut_from_dressed: the skinning scales the garment's gap to the body with the
+  // girths, so where the new body's ellipsoids bulge past it the cut is let out instead of
+  // stretched (on a 1.2 m / BMI 16 body that took the P99 stretch from 0.44 to 0.27). The cut carried is always the one create() got, bound to the rest body of that time,
+  // so refitting back and forth does not drift. Same particles, triangles, attachments, solver
+  // and parameters; it sits on the new rest pose until its first step places it on the tracked
+  // body (as a new garment does). Null + err when the dressing fails. docs/garments.md, "Body
+  // shape changes".
+  std::unique_ptr<GarmentSim> refitted(const BodyModel& body_rest, const std::vector<Ellipsoid>& rest_ellipsoids,
+                                       const std::vector<int>& ellipsoid_chains, std::string& err) const;
+  // Takes over `fresh` (from refitted()) and keeps what identifies this garment to its owner: the
+  // C ABI token and owner, its step count and glitch counters.
+  void replaceWith(GarmentSim&& fresh);
+
   bool setParams(const GarmentSimParams& params, std::string& err);
   const GarmentSimParams& params() const { return params_; }
   ClothSolverKind solver() const { return kind_; }
@@ -238,6 +254,17 @@ class GarmentSim {
   uint32_t jump_restores_ = 0, burst_restores_ = 0;
   std::vector<Ellipsoid> catch_kept_, catch_a_, catch_b_;  // restoreState scratch
   std::vector<Vec3> catch_kept_pins_, catch_pins_;
+
+  // What refitted() carries to another body: the mesh and choices create() got, and that mesh
+  // bound to the rest body of the time. Shared by a garment and its refits.
+  struct Origin {
+    GarmentMesh mesh;
+    TopologyParams topology;
+    float dress_time_s = 0.0f;
+    RingSkin skin;
+  };
+  std::shared_ptr<const Origin> origin_;
+  GarmentSim& operator=(GarmentSim&&) noexcept;  // replaceWith
 
   GarmentMesh mesh_;
   GarmentTopology topology_;
