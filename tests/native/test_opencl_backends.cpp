@@ -186,10 +186,7 @@ TEST(OpenClBackend, AGarmentRefittedToANewBodyShapeStaysOnTheDevice) {
   std::string err;
   GarmentSim* g = test::addTemplate(ctx, GarmentKind::TShirt, 300, ClothSolverKind::Xpbd, GarmentSimParams{}, err);
   ASSERT_NE(g, nullptr) << err;
-  drape_backend_desc d;
-  drape_backend_desc_init(&d);
-  d.backend = DRAPE_BACKEND_OPENCL;
-  ASSERT_EQ(ctx.setBackend(d, err), DRAPE_OK);
+  ASSERT_TRUE(chooseBackend(ctx, DRAPE_BACKEND_OPENCL, err)) << err;
   ASSERT_EQ(g->backend(), GarmentBackend::OpenCl);
   for (int f = 0; f < 5; ++f) stepPose(ctx, restPose(ctx.shape()), f / 30.0, 1.0f / 30.0f);
   BodyShapeInput tall;
