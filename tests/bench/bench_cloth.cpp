@@ -104,7 +104,8 @@ BENCHMARK(BM_ClothMassSpringFrame)
 // One cloth step per recording frame at 1/30 s, 10 substeps, collision against the ~137 Drape
 // ellipsoids interpolated across the substeps. Times setPinTargets + setColliderMotion + step.
 // Counters: ns per particle per substep, total and split (constraints = predict, XPBD projection
-// and velocity update; collision = per-substep collider setup + collide()).
+// and velocity update; collision = per-substep collider setup + collide()). Arg batch8: the
+// collider's pass 0 eight particles at a time (1, the default) or one at a time (0).
 void BM_GarmentFrame(benchmark::State& state) {
   static std::map<int, std::unique_ptr<GarmentScene>> cache;
   const int target = static_cast<int>(state.range(0));
@@ -115,6 +116,9 @@ void BM_GarmentFrame(benchmark::State& state) {
   s.transform(scene->rotation, scene->pivot, scene->shift, 0.0f);
   EllipsoidCollider collider;
   std::string error;
+  XpbdParams params;
+  params.collision.batch8 = state.range(1) != 0;  // pass 0 for 8 particles at once (same results)
+  s.setParams(params, error);
   const size_t frames = scene->pins.size();
   constexpr int kSubsteps = XpbdSolver::kDefaultSubsteps;
   size_t frame = 0;
@@ -154,7 +158,10 @@ void BM_GarmentFrame(benchmark::State& state) {
   state.counters["tests_per"] = tests / per;
   state.counters["escapes"] = escapes / static_cast<double>(state.iterations());
 }
-BENCHMARK(BM_GarmentFrame)->Arg(2000)->Arg(8000)->Arg(32000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_GarmentFrame)
+    ->ArgNames({"particles", "batch8"})
+    ->ArgsProduct({{2000, 8000, 32000}, {0, 1}})
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace drape

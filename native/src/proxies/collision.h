@@ -33,6 +33,10 @@ struct CollisionParams {
   // way out is through one of the parts, which tears the cloth apart. <= 0: no limit (then every
   // particle is guaranteed outside every ellipsoid). Garments use 1 cm (GarmentSimParams).
   float max_escape_m = 0.0f;
+  // Pass 0 (the discrete and swept tests) for 8 consecutive particles at once where the CPU has
+  // AVX: the same tests in the same order and arithmetic per particle, so the same results
+  // (bit-identical); off = one particle at a time. docs/collision.md, "Eight particles at once".
+  bool batch8 = true;
 };
 
 struct CollisionStats {
@@ -136,6 +140,14 @@ class EllipsoidCollider {
   int firstContaining(const Vec3& x, bool use_grid, const uint64_t* allowed, CollisionStats& stats) const;
   void resolveParticle(Vec3& x, const Vec3& x0, bool has_prev, const CollisionParams& p,
                        const uint64_t* allowed, CollisionStats& stats) const;
+  // resolveParticle after pass 0 moved x: the further sequential passes and the escape step.
+  // first: pass 0's candidates for this particle, or null (then gathered where needed).
+  void settle(Vec3& x, const Candidates* first, const CollisionParams& p, bool use_grid,
+              const uint64_t* allowed, CollisionStats& stats) const;
+  // collide() for particles [begin, begin + 8) (CollisionParams::batch8); false when the CPU has
+  // no AVX (nothing done).
+  bool collideEight(Eigen::Vector4f* positions, const Eigen::Vector4f* previous, size_t begin,
+                    const CollisionParams& p, bool grouped, CollisionStats& st) const;
   Vec3 respond(const Shape& s, const Vec3& x, const Vec3& q, float r2, ContactResponse mode,
                Vec3& q_contact) const;
   void refreshQuick(int k);
