@@ -1,33 +1,16 @@
 #include "proxies/collision.h"
 
 #include "proxies/closest_point.h"
+#include "proxies/collision_internal.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#if defined(_MSC_VER)
-#include <intrin.h>
-#endif
-#if defined(__SSE2__) || defined(_M_X64)
-#include <emmintrin.h>
-#endif
-#if (defined(__GNUC__) || defined(__clang__)) && (defined(__x86_64__) || defined(__i386__))
-#include <immintrin.h>
-#endif
-
 namespace drape {
-namespace {
+using namespace collision_internal;
 
-inline int lowestBit(uint64_t m) {
-#if defined(_MSC_VER)
-  unsigned long index = 0;
-  _BitScanForward64(&index, m);
-  return static_cast<int>(index);
-#else
-  return __builtin_ctzll(m);
-#endif
-}
+namespace {
 
 // 3x3 times 3-vector written out: GCC does not always inline Eigen's small products.
 inline Vec3 mulv(const Mat3& m, const Vec3& v) {
@@ -35,25 +18,6 @@ inline Vec3 mulv(const Mat3& m, const Vec3& v) {
 }
 inline Vec3 mulvT(const Mat3& m, const Vec3& v) {  // m^T v
   return Vec3(m.col(0).dot(v), m.col(1).dot(v), m.col(2).dot(v));
-}
-
-// Box tests with & rather than &&: no branch per comparison (random particle data mispredicts).
-inline bool containsPoint(const Vec3& mn, const Vec3& mx, const Vec3& p) {
-  return (p.x() >= mn.x()) & (p.x() <= mx.x()) & (p.y() >= mn.y()) & (p.y() <= mx.y()) &
-         (p.z() >= mn.z()) & (p.z() <= mx.z());
-}
-
-inline bool overlaps(const Vec3& lo, const Vec3& hi, const Vec3& mn, const Vec3& mx) {
-  return (lo.x() <= mx.x()) & (hi.x() >= mn.x()) & (lo.y() <= mx.y()) & (hi.y() >= mn.y()) &
-         (lo.z() <= mx.z()) & (hi.z() >= mn.z());
-}
-
-// Cell coordinates of a point (4-wide: the w lane is ignored), clamped to the grid. Monotone in
-// each coordinate, so a point inside two boxes lies in a cell both boxes' cell ranges include.
-inline Eigen::Array4i cellsOf(const Vec3& p, const Eigen::Array4f& origin, const Eigen::Array4f& scale,
-                              const Eigen::Array4f& top) {
-  const Eigen::Array4f v(p.x(), p.y(), p.z(), 0.0f);
-  return ((v - origin) * scale).max(Eigen::Array4f::Zero()).min(top).cast<int>();
 }
 
 // Positional Coulomb friction against the moving surface (Macklin et al. 2014, §6.1). qc is the
@@ -77,42 +41,6 @@ inline void applyFriction(const Mat3& to_unit_end, const Vec3& c_end, const Mat3
   const float f = slip2 < mu_s * mu_s * depth2 ? 1.0f : kinetic;
   x -= f * tangential;
 }
-
-using Vec4 = Eigen::Vector4f;
-// xyz0 built in registers: going through a 12-byte store and a 16-byte load stalls on store
-// forwarding (it cost more than the narrow test itself).
-#if defined(__SSE2__) || defined(_M_X64)
-inline Vec4 lift(const Vec3& v) {
-  const __m128 xy = _mm_unpacklo_ps(_mm_set_ss(v.x()), _mm_set_ss(v.y()));
-  Vec4 out;
-  _mm_store_ps(out.data(), _mm_movelh_ps(xy, _mm_set_ss(v.z())));
-  return out;
-}
-#else
-inline Vec4 lift(const Vec3& v) { return Vec4(v.x(), v.y(), v.z(), 0.0f); }
-#endif
-// q = U d for U given by its columns (w lanes 0).
-inline Vec4 mulq(const Vec4* u, const Vec4& d) {
-  return u[0] * d.x() + u[1] * d.y() + u[2] * d.z();
-}
-// Box tests on 4 lanes (w lanes are 0 on both sides, so they always pass), one branch.
-#if defined(__SSE2__) || defined(_M_X64)
-inline bool overlaps4(const Vec4& lo, const Vec4& hi, const Vec4& mn, const Vec4& mx) {
-  const __m128 in = _mm_and_ps(_mm_cmple_ps(_mm_load_ps(lo.data()), _mm_load_ps(mx.data())),
-                               _mm_cmpge_ps(_mm_load_ps(hi.data()), _mm_load_ps(mn.data())));
-  return _mm_movemask_ps(in) == 0xF;
-}
-inline bool contains4(const Vec4& mn, const Vec4& mx, const Vec4& p) {
-  return overlaps4(p, p, mn, mx);
-}
-#else
-inline bool overlaps4(const Vec4& lo, const Vec4& hi, const Vec4& mn, const Vec4& mx) {
-  return ((lo.array() <= mx.array()).cast<int>() * (hi.array() >= mn.array()).cast<int>()).sum() == 4;
-}
-inline bool contains4(const Vec4& mn, const Vec4& mx, const Vec4& p) {
-  return overlaps4(p, p, mn, mx);
-}
-#endif
 
 // Closest point on an ellipsoid (radii^2 b, local frame) to the local point y = e * q inside it
 // near its surface (|q|^2 = r2 >= 0.64), in float: x_i = b_i y_i / (b_i + t) with t the root of
@@ -311,70 +239,6 @@ void EllipsoidCollider::refreshQuick(int k) {
   q.radii2 = lift(s.radii.cwiseProduct(s.radii));
   q.inside_tol2 = s.inside_tol2;
   q.graze = s.graze;
-}
-
-#if defined(__GNUC__)
-#define DRAPE_ALWAYS_INLINE __attribute__((always_inline)) inline
-#define DRAPE_LAMBDA_INLINE __attribute__((always_inline))
-#else
-#define DRAPE_ALWAYS_INLINE inline
-#define DRAPE_LAMBDA_INLINE
-#endif
-
-DRAPE_ALWAYS_INLINE bool EllipsoidCollider::gather(const Vec3& lo, const Vec3& hi, bool use_grid,
-                                                   const uint64_t* allowed, Candidates& c) const {
-  if (!overlaps(lo, hi, grid_min_, grid_max_)) return false;  // outside every swept box
-  c.all = !use_grid;
-  c.allowed = allowed;
-  if (c.all) return true;
-  c.lo = cellsOf(lo, cell_origin_, cell_scale_, cell_top_);
-  c.hi = cellsOf(hi, cell_origin_, cell_scale_, cell_top_);
-  if ((c.lo == c.hi).all()) {  // the usual case: one cell
-    const uint64_t* cell =
-        &cells_[static_cast<size_t>(((c.lo[2] * dims_[1] + c.lo[1]) * dims_[0] + c.lo[0]) * words_)];
-    if (allowed) {
-      for (int w = 0; w < words_; ++w) c.mask[w] = cell[w] & allowed[w];
-    } else {
-      for (int w = 0; w < words_; ++w) c.mask[w] = cell[w];
-    }
-    return true;
-  }
-  for (int w = 0; w < words_; ++w) c.mask[w] = 0;
-  for (int z = c.lo[2]; z <= c.hi[2]; ++z) {
-    for (int y = c.lo[1]; y <= c.hi[1]; ++y) {
-      for (int x = c.lo[0]; x <= c.hi[0]; ++x) {
-        const uint64_t* cell = &cells_[static_cast<size_t>(((z * dims_[1] + y) * dims_[0] + x) * words_)];
-        for (int w = 0; w < words_; ++w) c.mask[w] |= cell[w];
-      }
-    }
-  }
-  if (allowed)
-    for (int w = 0; w < words_; ++w) c.mask[w] &= allowed[w];
-  return true;
-}
-
-bool EllipsoidCollider::covers(const Candidates& c, const Vec3& p) const {
-  if (c.all) return true;
-  const Eigen::Array4i i = cellsOf(p, cell_origin_, cell_scale_, cell_top_);
-  return (i >= c.lo).all() && (i <= c.hi).all();
-}
-
-template <class F>
-void EllipsoidCollider::iterate(const Candidates& c, F&& f) const {
-  if (c.all) {
-    const int n = count();
-    for (int k = 0; k < n; ++k)
-      if (!c.allowed || ((c.allowed[k >> 6] >> (k & 63)) & 1u)) f(k);
-    return;
-  }
-  for (int w = 0; w < words_; ++w) {
-    uint64_t m = c.mask[w];
-    while (m) {
-      const int k = (w << 6) + lowestBit(m);
-      m &= m - 1;
-      f(k);
-    }
-  }
 }
 
 template <class F>
@@ -633,178 +497,6 @@ void EllipsoidCollider::settle(Vec3& x, const Candidates* first, const Collision
   }
 }
 
-#if (defined(__GNUC__) || defined(__clang__)) && (defined(__x86_64__) || defined(__i386__))
-namespace {
-bool cpuHasAvx() {
-  static const bool avx = __builtin_cpu_supports("avx");
-  return avx;
-}
-// The 8 lanes of v.
-struct Lanes {
-  alignas(32) float v[8];
-};
-#define DRAPE_AVX_INLINE __attribute__((target("avx"), always_inline)) inline
-DRAPE_AVX_INLINE __m256 bcast(float f) { return _mm256_set1_ps(f); }
-// q = U (p - c) per lane, as mulq: (u0 * d.x + u1 * d.y) + u2 * d.z per component.
-DRAPE_AVX_INLINE void unitSpace8(const Vec4* u, const Vec4& cen, __m256 px, __m256 py, __m256 pz, __m256& qx,
-                                 __m256& qy, __m256& qz) {
-  const __m256 dx = _mm256_sub_ps(px, bcast(cen.x())), dy = _mm256_sub_ps(py, bcast(cen.y())),
-               dz = _mm256_sub_ps(pz, bcast(cen.z()));
-  qx = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(bcast(u[0].x()), dx), _mm256_mul_ps(bcast(u[1].x()), dy)),
-                     _mm256_mul_ps(bcast(u[2].x()), dz));
-  qy = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(bcast(u[0].y()), dx), _mm256_mul_ps(bcast(u[1].y()), dy)),
-                     _mm256_mul_ps(bcast(u[2].y()), dz));
-  qz = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(bcast(u[0].z()), dx), _mm256_mul_ps(bcast(u[1].z()), dy)),
-                     _mm256_mul_ps(bcast(u[2].z()), dz));
-}
-// a.b as Eigen sums a 4-lane packet with w = 0 (SSE predux): (x + z) + y.
-DRAPE_AVX_INLINE __m256 dot8(__m256 ax, __m256 ay, __m256 az, __m256 bx, __m256 by, __m256 bz) {
-  return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ax, bx), _mm256_mul_ps(az, bz)), _mm256_mul_ps(ay, by));
-}
-// lo <= mx and hi >= mn on each axis, per lane.
-DRAPE_AVX_INLINE __m256 boxes8(__m256 lox, __m256 loy, __m256 loz, __m256 hix, __m256 hiy, __m256 hiz,
-                               const Vec4& mn, const Vec4& mx) {
-  return _mm256_and_ps(
-      _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(lox, bcast(mx.x()), _CMP_LE_OQ), _mm256_cmp_ps(hix, bcast(mn.x()), _CMP_GE_OQ)),
-                    _mm256_and_ps(_mm256_cmp_ps(loy, bcast(mx.y()), _CMP_LE_OQ), _mm256_cmp_ps(hiy, bcast(mn.y()), _CMP_GE_OQ))),
-      _mm256_and_ps(_mm256_cmp_ps(loz, bcast(mx.z()), _CMP_LE_OQ), _mm256_cmp_ps(hiz, bcast(mn.z()), _CMP_GE_OQ)));
-}
-}  // namespace
-
-// Pass 0 of resolveParticle for 8 particles, lane by lane the same arithmetic in the same order
-// (Eigen's 4-lane sums are (x + z) + y with w = 0, reproduced below; no FMA), so every particle
-// meets the same tests with the same values and gets the same contacts: bit-identical results.
-// What it saves is per-particle overhead: one grid gather for the 8 particles' joint box instead
-// of 8, and one box test and narrow test per candidate for 8 particles. Contacts (rare: under 10 %
-// of particle tests) and the later passes stay one particle at a time.
-__attribute__((target("avx"))) bool EllipsoidCollider::collideEight(Eigen::Vector4f* positions,
-                                                                     const Eigen::Vector4f* previous,
-                                                                     size_t begin, const CollisionParams& p,
-                                                                     bool grouped, CollisionStats& st) const {
-  // More ellipsoids than the grid takes (broad phase off): one particle at a time.
-  if (!cpuHasAvx() || shapes_.size() > static_cast<size_t>(kMaxGridEllipsoids)) return false;
-  const bool swept = p.continuous && previous != nullptr;
-  const bool use_grid = p.broad_phase && grid_;
-  const bool any_friction = p.static_friction > 0.0f || p.kinetic_friction > 0.0f;
-  Lanes X, Y, Z, X0, Y0, Z0, LOX, LOY, LOZ, HIX, HIY, HIZ;
-  const uint64_t* allowed[8];
-  Vec3 start[8];
-  int active = 0;  // bit j: lane j takes part in the batched pass 0
-  uint64_t joint_allowed[kMaxGridEllipsoids / 64] = {};
-  Vec3 lo = Vec3::Constant(std::numeric_limits<float>::infinity()), hi = -lo;
-  for (int j = 0; j < 8; ++j) {
-    const size_t i = begin + static_cast<size_t>(j);
-    // The same rejections as collide()'s particle loop.
-    if (!(positions[i].w() > 0.0f)) continue;
-    const Vec3 x = positions[i].head<3>();
-    if (!containsPoint(grid_min_, grid_max_, x)) {
-      if (!swept) continue;
-      const Vec3 p0 = previous[i].head<3>();
-      if (!overlaps(x.cwiseMin(p0), x.cwiseMax(p0), grid_min_, grid_max_)) continue;
-    }
-    if (!isFinite(x)) continue;
-    allowed[j] = grouped ? &allowed_[static_cast<size_t>(particle_masks_[i]) * (kMaxGridEllipsoids / 64)] : nullptr;
-    const Vec3 x0 = previous ? Vec3(previous[i].head<3>()) : x;
-    if (previous && !isFinite(x0)) {  // no start position: the one-particle path
-      Vec3 y = x;
-      resolveParticle(y, x, false, p, allowed[j], st);
-      if (y != x) positions[i].head<3>() = y;
-      continue;
-    }
-    active |= 1 << j;
-    start[j] = x0;
-    X.v[j] = x.x(), Y.v[j] = x.y(), Z.v[j] = x.z();
-    X0.v[j] = x0.x(), Y0.v[j] = x0.y(), Z0.v[j] = x0.z();
-    const Vec3 l = swept ? x.cwiseMin(x0) : x, h = swept ? x.cwiseMax(x0) : x;
-    LOX.v[j] = l.x(), LOY.v[j] = l.y(), LOZ.v[j] = l.z();
-    HIX.v[j] = h.x(), HIY.v[j] = h.y(), HIZ.v[j] = h.z();
-    lo = lo.cwiseMin(l);
-    hi = hi.cwiseMax(h);
-    if (allowed[j])
-      for (int w = 0; w < words_; ++w) joint_allowed[w] |= allowed[j][w];
-  }
-  Candidates c;
-  if (active == 0 || !gather(lo, hi, use_grid, grouped ? joint_allowed : nullptr, c)) return true;
-  const bool has_prev = previous != nullptr;
-  const bool cont = p.continuous && has_prev;
-  const bool friction = has_prev && any_friction;
-  const __m256 lox = _mm256_load_ps(LOX.v), loy = _mm256_load_ps(LOY.v), loz = _mm256_load_ps(LOZ.v);
-  const __m256 hix = _mm256_load_ps(HIX.v), hiy = _mm256_load_ps(HIY.v), hiz = _mm256_load_ps(HIZ.v);
-  const __m256 x0x = _mm256_load_ps(X0.v), x0y = _mm256_load_ps(Y0.v), x0z = _mm256_load_ps(Z0.v);
-  const __m256 one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps();
-  int moved = 0;
-  int ks[kMaxGridEllipsoids];
-  int candidates = 0;
-  iterate(c, [&](int k) { ks[candidates++] = k; });
-  for (int n = 0; n < candidates; ++n) {
-    const int k = ks[n];
-    const Quick& qk = quick_[static_cast<size_t>(k)];
-    int lanes = active;
-    if (grouped)
-      for (int j = 0; j < 8; ++j)
-        if (((lanes >> j) & 1) && !((allowed[j][k >> 6] >> (k & 63)) & 1u)) lanes &= ~(1 << j);
-    const __m256 px = _mm256_load_ps(X.v), py = _mm256_load_ps(Y.v), pz = _mm256_load_ps(Z.v);
-    // The swept box (fixed per particle) against the ellipsoid's swept box, or the end position
-    // as pass 0 saw it (lo = hi = x then) in the end box.
-    const __m256 in_box = cont ? boxes8(lox, loy, loz, hix, hiy, hiz, qk.swept_min, qk.swept_max)
-                               : boxes8(lox, loy, loz, hix, hiy, hiz, qk.end_min, qk.end_max);
-    lanes &= _mm256_movemask_ps(in_box);
-    if (!lanes) continue;
-    st.tests += static_cast<uint32_t>(__builtin_popcount(static_cast<unsigned>(lanes)));
-    __m256 q1x, q1y, q1z;
-    unitSpace8(qk.end_u, qk.end_c, px, py, pz, q1x, q1y, q1z);
-    const __m256 r2 = dot8(q1x, q1y, q1z, q1x, q1y, q1z);
-    const __m256 inside = _mm256_cmp_ps(r2, one, _CMP_LT_OQ);
-    __m256 q0x = zero, q0y = zero, q0z = zero, q0sq = zero, hit = inside;
-    if (cont) {
-      unitSpace8(qk.start_u, qk.start_c, x0x, x0y, x0z, q0x, q0y, q0z);
-      q0sq = dot8(q0x, q0y, q0z, q0x, q0y, q0z);
-      const __m256 dx = _mm256_sub_ps(q1x, q0x), dy = _mm256_sub_ps(q1y, q0y), dz = _mm256_sub_ps(q1z, q0z);
-      const __m256 a = dot8(dx, dy, dz, dx, dy, dz), b = dot8(q0x, q0y, q0z, dx, dy, dz);
-      const __m256 graze_a = _mm256_mul_ps(bcast(qk.graze), a);
-      const __m256 crossed = _mm256_and_ps(
-          _mm256_and_ps(_mm256_andnot_ps(inside, _mm256_cmp_ps(q0sq, one, _CMP_GE_OQ)),
-                        _mm256_and_ps(_mm256_cmp_ps(b, zero, _CMP_LT_OQ), _mm256_cmp_ps(a, zero, _CMP_GT_OQ))),
-          _mm256_and_ps(_mm256_cmp_ps(_mm256_sub_ps(zero, b), a, _CMP_LE_OQ),
-                        _mm256_cmp_ps(_mm256_sub_ps(_mm256_mul_ps(q0sq, a), _mm256_mul_ps(b, b)), graze_a,
-                                      _CMP_LT_OQ)));
-      hit = _mm256_or_ps(inside, crossed);
-    }
-    int contacts = lanes & _mm256_movemask_ps(hit);
-    if (!contacts) continue;
-    Lanes Q1X, Q1Y, Q1Z, R2, Q0X, Q0Y, Q0Z, Q0SQ;
-    _mm256_store_ps(Q1X.v, q1x), _mm256_store_ps(Q1Y.v, q1y), _mm256_store_ps(Q1Z.v, q1z);
-    _mm256_store_ps(R2.v, r2);
-    _mm256_store_ps(Q0X.v, q0x), _mm256_store_ps(Q0Y.v, q0y), _mm256_store_ps(Q0Z.v, q0z);
-    _mm256_store_ps(Q0SQ.v, q0sq);
-    const int inside_bits = _mm256_movemask_ps(inside);
-    while (contacts) {
-      const int j = __builtin_ctz(static_cast<unsigned>(contacts));
-      contacts &= contacts - 1;
-      Vec3 x(X.v[j], Y.v[j], Z.v[j]);
-      contact(shapes_[static_cast<size_t>(k)], Vec4(Q1X.v[j], Q1Y.v[j], Q1Z.v[j], 0.0f), R2.v[j],
-              Vec4(Q0X.v[j], Q0Y.v[j], Q0Z.v[j], 0.0f), Q0SQ.v[j], (inside_bits >> j) & 1, cont, friction,
-              start[j], p, x, st);
-      X.v[j] = x.x(), Y.v[j] = x.y(), Z.v[j] = x.z();
-      moved |= 1 << j;
-    }
-  }
-  for (int j = 0; j < 8; ++j) {
-    if (!((moved >> j) & 1)) continue;
-    Vec3 x(X.v[j], Y.v[j], Z.v[j]);
-    settle(x, nullptr, p, use_grid, allowed[j], st);
-    const size_t i = begin + static_cast<size_t>(j);
-    if (x != Vec3(positions[i].head<3>())) positions[i].head<3>() = x;
-  }
-  return true;
-}
-#else
-bool EllipsoidCollider::collideEight(Eigen::Vector4f*, const Eigen::Vector4f*, size_t, const CollisionParams&,
-                                     bool, CollisionStats&) const {
-  return false;
-}
-#endif
-
 void EllipsoidCollider::setGroups(const std::vector<uint8_t>& ellipsoid_groups, const uint8_t* particle_masks) {
   groups_ = ellipsoid_groups;
   particle_masks_ = particle_masks;
@@ -833,16 +525,8 @@ CollisionStats EllipsoidCollider::collide(Eigen::Vector4f* positions,
   if (p.batch8)
     for (; i + 8 <= count && collideEight(positions, previous, i, p, grouped, st); i += 8) {}
   for (; i < count; ++i) {
-    if (!(positions[i].w() > 0.0f)) continue;
+    if (!mayTouch(positions, previous, i, swept)) continue;
     const Vec3 x = positions[i].head<3>();
-    // Cheap reject before anything else: nowhere near any ellipsoid's (swept) box. NaN fails
-    // every comparison and is rejected here too, unless the previous position is finite.
-    if (!containsPoint(grid_min_, grid_max_, x)) {
-      if (!swept) continue;
-      const Vec3 p0 = previous[i].head<3>();
-      if (!overlaps(x.cwiseMin(p0), x.cwiseMax(p0), grid_min_, grid_max_)) continue;
-    }
-    if (!isFinite(x)) continue;
     Vec3 x0 = x;
     bool has_prev = false;
     if (previous) {
