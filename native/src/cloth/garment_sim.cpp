@@ -202,7 +202,7 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
     origin->mesh = mesh;
     origin->topology = topo;
     origin->dress_time_s = dress_time_s;
-    origin->skin.bind(body_rest, mesh.positions, kSkinBlendM);
+    origin->rest_rings = body_rest.rings();
     g->origin_ = std::move(origin);
   }
 
@@ -282,8 +282,14 @@ std::unique_ptr<GarmentSim> GarmentSim::refitted(const BodyModel& body_rest,
                                                  const std::vector<int>& ellipsoid_chains,
                                                  std::string& err) const {
   const Origin& o = *origin_;
+  if (o.rest_rings.size() != body_rest.rings().size()) {
+    err = "the new body has another ring layout than the one the garment was made on";
+    return nullptr;
+  }
   GarmentMesh mesh = o.mesh;
-  o.skin.place(body_rest, mesh.positions);
+  RingSkin skin;
+  skin.bind(body_rest, o.rest_rings, o.mesh.positions, kSkinBlendM);
+  skin.place(body_rest, mesh.positions);
   // Attachments keep their ring; their offset from it follows the carried cut (the ring grew or
   // shrank with the body, so the old offset in metres would put the pin inside or off the body).
   for (size_t k = 0; k < mesh.pinned.size(); ++k) {

@@ -255,13 +255,14 @@ class GarmentSim {
   std::vector<Ellipsoid> catch_kept_, catch_a_, catch_b_;  // restoreState scratch
   std::vector<Vec3> catch_kept_pins_, catch_pins_;
 
-  // What refitted() carries to another body: the mesh and choices create() got, and that mesh
-  // bound to the rest body of the time. Shared by a garment and its refits.
+  // What refitted() carries to another body: the mesh and choices create() got, and the rings
+  // of the rest body of the time (the mesh is bound to them when a refit needs it, not at every
+  // creation: binding costs ~100 ms at 32 000 particles). Shared by a garment and its refits.
   struct Origin {
     GarmentMesh mesh;
     TopologyParams topology;
     float dress_time_s = 0.0f;
-    RingSkin skin;
+    std::vector<RingPose> rest_rings;
   };
   std::shared_ptr<const Origin> origin_;
   GarmentSim& operator=(GarmentSim&&) noexcept;  // replaceWith

@@ -56,7 +56,12 @@ Vec3 placeBinding(const std::vector<RingPose>& rings, const RingBinding& b) {
 }
 
 void RingSkin::bind(const BodyModel& body, const std::vector<Vec3>& points, float blend_m) {
-  const std::vector<RingPose>& rings = body.rings();
+  bind(body, body.rings(), points, blend_m);
+}
+
+void RingSkin::bind(const BodyModel& layout, const std::vector<RingPose>& rings, const std::vector<Vec3>& points,
+                    float blend_m) {
+  const BodyModel& body = layout;
   primary_.assign(points.size(), RingBinding{});
   blend_.clear();
   weight_.clear();

@@ -31,6 +31,10 @@ class RingSkin {
  public:
   // Binds every point to `body` (updated with a pose). blend_m >= 0; 0 = nearest segment only.
   void bind(const BodyModel& body, const std::vector<Vec3>& points, float blend_m);
+  // The same on `rings`, an earlier state of a body with `layout`'s ring layout (rings kept from
+  // another shape or pose). rings.size() must be layout.rings().size().
+  void bind(const BodyModel& layout, const std::vector<RingPose>& rings, const std::vector<Vec3>& points,
+            float blend_m);
   // The points on `body` (same ring layout as at bind time). `out` is resized.
   void place(const BodyModel& body, std::vector<Vec3>& out) const;
   // Point i placed on `rings`.
