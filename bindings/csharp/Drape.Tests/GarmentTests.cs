@@ -194,6 +194,46 @@ namespace Drape.Tests
             Assert.NotEqual(positions, later);
         }
 
+        [Fact]
+        public void SetBodyShape_RefitsTheWornGarment_SameVerticesLongerCut()
+        {
+            using var ctx = new Context();
+            using Garment g = ctx.AddGarment(Small());
+            StepFrames(ctx, 10);
+            int vertices = g.VertexCount, indices = g.IndexCount;
+            var restBefore = new Vector3f[vertices];
+            g.ReadRestPositions(restBefore);
+
+            BodyShape tall = BodyShape.CreateDefault();
+            tall.HeightM = 2.0f;
+            tall.WeightKg = 110f;
+            ctx.SetBodyShape(tall);
+
+            // The same garment object, vertices and triangles; the cut follows the taller body.
+            Assert.Equal(new[] { g }, ctx.Garments);
+            Assert.Equal(vertices, g.VertexCount);
+            Assert.Equal(indices, g.IndexCount);
+            var restAfter = new Vector3f[vertices];
+            g.ReadRestPositions(restAfter);
+            float Height(Vector3f[] p) => p.Max(v => v.Y) - p.Min(v => v.Y);
+            Assert.True(Height(restAfter) > 1.1f * Height(restBefore),
+                        $"rest height {Height(restBefore):F3} m -> {Height(restAfter):F3} m");
+
+            StepFrames(ctx, 10, 10);
+            ReadAndCheck(g);
+            Assert.Equal(20ul, g.Stats.Steps);
+            GarmentAccuracy a = g.Measure();
+            Assert.True(a.P99Stretch < 0.5f, $"p99 stretch {a.P99Stretch}");
+
+            // The same shape again changes nothing.
+            var before = new Vector3f[vertices];
+            g.ReadPositions(before);
+            ctx.SetBodyShape(tall);
+            var again = new Vector3f[vertices];
+            g.ReadPositions(again);
+            Assert.Equal(before, again);
+        }
+
         [Theory]
         [InlineData(GarmentKind.TShirt)]
         [InlineData(GarmentKind.LongSleeve)]
