@@ -19,7 +19,7 @@
 namespace drape {
 namespace {
 
-BodyShapeInput shapeOf(float height_m, float bmi) {
+BodyShapeInput bodyOfHeightBmi(float height_m, float bmi) {
   BodyShapeInput in;
   in.height_m = height_m;
   in.weight_kg = bmi * height_m * height_m;
@@ -72,13 +72,13 @@ struct Wearer {
   }
 };
 
-const BodyShapeInput kDefault = shapeOf(1.70f, 65.0f / (1.70f * 1.70f));
-const BodyShapeInput kTallHeavy = shapeOf(2.1f, 40.0f);
-const BodyShapeInput kShortThin = shapeOf(1.2f, 16.0f);
+const BodyShapeInput kDefaultBody = bodyOfHeightBmi(1.70f, 65.0f / (1.70f * 1.70f));
+const BodyShapeInput kTallHeavy = bodyOfHeightBmi(2.1f, 40.0f);
+const BodyShapeInput kShortThin = bodyOfHeightBmi(1.2f, 16.0f);
 
 TEST(GarmentRefit, FitsTheNewBodyAboutAsWellAsAGarmentMadeForIt) {
   for (const BodyShapeInput& other : {kTallHeavy, kShortThin}) {
-    Wearer worn(kDefault);
+    Wearer worn(kDefaultBody);
     ASSERT_NE(worn.garment, nullptr);
     const size_t particles = worn.garment->particleCount();
     const std::vector<uint32_t> triangles = worn.garment->indices();
@@ -95,7 +95,7 @@ TEST(GarmentRefit, FitsTheNewBodyAboutAsWellAsAGarmentMadeForIt) {
     // The same template made for the other body, at the same moment of the same take: the tracker
     // calibrated its bone lengths on the first person (SkeletonTracker), so both garments meet
     // the same tracked skeleton.
-    Wearer made(kDefault, /*dressed=*/false);
+    Wearer made(kDefaultBody, /*dressed=*/false);
     for (int f = 0; f < 30; ++f) made.step();
     ASSERT_EQ(made.ctx->setShape(other, err), DRAPE_OK) << err;
     made.dress();
@@ -112,11 +112,11 @@ TEST(GarmentRefit, FitsTheNewBodyAboutAsWellAsAGarmentMadeForIt) {
 }
 
 TEST(GarmentRefit, ChangingBackRestoresTheOriginalCut) {
-  Wearer w(kDefault);
+  Wearer w(kDefaultBody);
   ASSERT_NE(w.garment, nullptr);
   const DistanceConstraints original = w.garment->topology().stretch;
   std::string err;
-  for (const BodyShapeInput& s : {kTallHeavy, kShortThin, kDefault}) {
+  for (const BodyShapeInput& s : {kTallHeavy, kShortThin, kDefaultBody}) {
     ASSERT_EQ(w.ctx->setShape(s, err), DRAPE_OK) << err;
     w.step();
     if (&s == &kTallHeavy) {
@@ -158,7 +158,7 @@ TEST(GarmentRefit, TheSameShapeAgainChangesNothing) {
 TEST(GarmentRefit, ARejectedShapeLeavesTheGarmentBitIdentical) {
   // (The other failure, a garment whose dressing on the new body is not finite, restores the old
   // shape the same way; no valid parameters reach it, so it is not provoked here.)
-  Wearer w(kDefault);
+  Wearer w(kDefaultBody);
   ASSERT_NE(w.garment, nullptr);
   for (int f = 0; f < 10; ++f) w.step();
   std::vector<Eigen::Vector4f> before(w.garment->positions(), w.garment->positions() + w.garment->particleCount());
