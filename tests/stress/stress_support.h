@@ -5,6 +5,7 @@
 #pragma once
 
 #include "capi_test_support.h"
+#include "sanitizer_scale.h"
 #include "test_data.h"
 
 #include <gtest/gtest.h>
@@ -14,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <initializer_list>
 #include <random>
 #include <cstdlib>
 #include <string>
@@ -85,11 +87,30 @@ inline bool loadTake(const std::string& path, Take& take, std::string& err) {
 
 // The scenarios dress a 1 000-particle T-shirt; DRAPE_STRESS_PARTICLES=N (>= 200) dresses another
 // resolution, to see how much a figure depends on it (docs/robustness.md, "Sensitivity").
+// Under the sanitizers (preset asan) the default is 400 particles: every scenario passes at 400 in
+// release and under ASan, and a replay costs about half as much there (docs/robustness.md,
+// "Sanitizers").
 inline uint32_t defaultParticles() {
+  const uint32_t fallback = drape::test::kSanitizedBuild ? 400u : 1000u;
   const char* w = std::getenv("DRAPE_STRESS_PARTICLES");
-  if (w == nullptr) return 1000u;
+  if (w == nullptr) return fallback;
   const int n = std::atoi(w);
-  return n >= 200 ? static_cast<uint32_t>(n) : 1000u;
+  return n >= 200 ? static_cast<uint32_t>(n) : fallback;
+}
+
+// The variants a scenario runs (frame rates, seeds, cases): all of `all` in a plain build; under
+// the sanitizers only those at the indices `under_sanitizers`, chosen so that they still run every
+// code path the scenario exists for (the others repeat those paths with other numbers, and each
+// costs several seconds under ASan). Release keeps every variant and every bound.
+template <typename T, size_t N>
+std::vector<T> variants(const T (&all)[N], std::initializer_list<size_t> under_sanitizers) {
+  if (!drape::test::kSanitizedBuild) return std::vector<T>(all, all + N);
+  std::vector<T> kept;
+  for (size_t i : under_sanitizers) {
+    if (i < N) kept.push_back(all[i]);
+    else ADD_FAILURE() << "variant " << i << " of " << N;
+  }
+  return kept;
 }
 
 struct Dressing {
@@ -102,6 +123,14 @@ struct Dressing {
   bool set_cloth = false;
   drape_cloth_params cloth{};
 };
+
+// How much of a take a scenario replays: all of it in a plain build; under the sanitizers only up
+// to `checked_until`, the end of the last window the scenario checks (its recovery window, or 3 s
+// after the disturbances start): the rest of the take only replays more undisturbed motion, at
+// 2-3 s of ASan time per replay (docs/robustness.md, "Sanitizers").
+inline double replayedSeconds(const Take& take, double checked_until) {
+  return drape::test::kSanitizedBuild ? std::min(take.duration(), checked_until) : take.duration();
+}
 
 // Per-frame figures of one run.
 struct Series {
@@ -260,15 +289,20 @@ inline std::vector<double> fixedTimes(double duration, double dt) {
 
 using Perturb = std::function<void(double t, Joints& j)>;
 
-// Replays `take` at `times` (the first frame steps 1/30 s) with `perturb` applied to each frame.
+// Replays `take` at `times` (the first frame steps 1/30 s) with `perturb` applied to each frame,
+// measuring every `measure_every` frames. Under the sanitizers half as often: the measurement (a
+// signed distance to the body mesh for every particle) is 59 % of a replay's ASan time, and the
+// checked figures are medians and maxima over windows that keep 15 measured frames or more.
 inline Series replay(const Take& take, const std::vector<double>& times, const Perturb& perturb = nullptr,
                      const Dressing& setup = Dressing(), int measure_every = 1) {
+  const size_t scale = drape::test::kSanitizedBuild ? 2 : 1;
+  const size_t stride = measure_every > 0 ? scale * static_cast<size_t>(measure_every) : 0;  // 0: none
   Scene scene(setup);
   for (size_t i = 0; i < times.size(); ++i) {
     Joints j = take.sample(times[i]);
     if (perturb) perturb(times[i], j);
     const float dt = i == 0 ? 1.0f / 30.0f : static_cast<float>(times[i] - times[i - 1]);
-    scene.frame(j, times[i], dt, measure_every > 0 && i % static_cast<size_t>(measure_every) == 0);
+    scene.frame(j, times[i], dt, stride > 0 && i % stride == 0);
   }
   return scene.series;
 }

@@ -1,6 +1,9 @@
 // Stress scenarios (issue 8, docs/robustness.md): real Kinect v2 takes from ../shared/data with a
 // perturbation applied to what the host pushes through the C ABI. Each scenario is compared with
 // the undisturbed run of the same take at the same frame times. Bounds: docs/robustness.md.
+// Under the sanitizers (preset asan) every scenario runs with every assertion, on less of the same
+// work: a 400-particle garment, the variants that cover its code paths (`variants`), the take up
+// to the end of its last checked window (`replayedSeconds`), every other frame measured (`replay`).
 #include "stress_support.h"
 
 namespace {
@@ -16,11 +19,15 @@ constexpr double kStart = 1.5;  // disturbances start here (after the 0.3 s blen
 
 TEST(StressFrameTimes, FixedRatesFrom240HzTo10Hz) {
   STRESS_REQUIRE_TAKE(take, kComeHere);
-  const Series control = replay(take, fixedTimes(take.duration(), 1.0 / 30.0));
+  const double seconds = replayedSeconds(take, kStart + 3.0);
+  const Series control = replay(take, fixedTimes(seconds, 1.0 / 30.0));
   print("30 Hz (undisturbed)", control);
   expectHealthy(control, "30 Hz");
-  for (double hz : {240.0, 120.0, 60.0, 15.0, 10.0}) {
-    const Series s = replay(take, fixedTimes(take.duration(), 1.0 / hz), nullptr, Dressing(), hz > 30 ? int(hz / 30) : 1);
+  // Under the sanitizers the two ends: 240 Hz (two substeps a frame, frames shorter than the
+  // Kinect's 1/30 s) and 10 Hz (a frame of max_step_s, 30 substeps).
+  const double rates[] = {240.0, 120.0, 60.0, 15.0, 10.0};
+  for (double hz : variants(rates, {0, 4})) {
+    const Series s = replay(take, fixedTimes(seconds, 1.0 / hz), nullptr, Dressing(), hz > 30 ? int(hz / 30) : 1);
     const std::string name = std::to_string(int(hz)) + " Hz";
     print(name.c_str(), s);
     expectHealthy(s, name.c_str());
@@ -33,12 +40,14 @@ TEST(StressFrameTimes, FixedRatesFrom240HzTo10Hz) {
 
 TEST(StressFrameTimes, IrregularFrom240HzTo10Hz) {
   STRESS_REQUIRE_TAKE(take, kComeHere);
-  const Series control = replay(take, fixedTimes(take.duration(), 1.0 / 30.0));
-  for (unsigned seed : {1u, 2u, 3u}) {
+  const double seconds = replayedSeconds(take, kStart + 3.0);
+  const Series control = replay(take, fixedTimes(seconds, 1.0 / 30.0));
+  const unsigned seeds[] = {1u, 2u, 3u};  // each draws frames over the whole range; one under the sanitizers
+  for (unsigned seed : variants(seeds, {0})) {
     std::mt19937 rng(seed);
     // Log-uniform in [1/240, 1/10]: many short frames and some long stalls, as a busy host gives.
     std::uniform_real_distribution<double> u(std::log(1.0 / 240.0), std::log(1.0 / 10.0));
-    const Series s = replay(take, frameTimes(take.duration(), [&] { return std::exp(u(rng)); }));
+    const Series s = replay(take, frameTimes(seconds, [&] { return std::exp(u(rng)); }));
     const std::string name = "irregular, seed " + std::to_string(seed);
     print(name.c_str(), s);
     expectHealthy(s, name.c_str());
@@ -53,9 +62,9 @@ TEST(StressFrameTimes, IrregularFrom240HzTo10Hz) {
 
 TEST(StressTeleport, TwoMetresForOneFrame) {
   STRESS_REQUIRE_TAKE(take, kComeHere);
-  const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
-  const Series control = replay(take, times);
   const double at = 2.0;
+  const std::vector<double> times = fixedTimes(replayedSeconds(take, at + 1.0 / 30.0 + 2.0), 1.0 / 30.0);
+  const Series control = replay(take, times);
   const Series s = replay(take, times, [&](double t, Joints& j) {
     if (std::abs(t - at) < 0.5 / 30.0)
       for (drape_joint& q : j) q.position.x += 2.0f;
@@ -68,10 +77,11 @@ TEST(StressTeleport, TwoMetresForOneFrame) {
 
 TEST(StressTeleport, TwoMetresForGood) {
   STRESS_REQUIRE_TAKE(take, kComeHere);
-  const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
-  const Series control = replay(take, times);
   const double at = 2.0;
-  for (float dx : {2.0f, -2.0f}) {
+  const std::vector<double> times = fixedTimes(replayedSeconds(take, at + 2.0), 1.0 / 30.0);
+  const Series control = replay(take, times);
+  const float jumps[] = {2.0f, -2.0f};  // the same path both ways; one under the sanitizers
+  for (float dx : variants(jumps, {0})) {
     const Series s = replay(take, times, [&](double t, Joints& j) {
       if (t >= at - 0.5 / 30.0)
         for (drape_joint& q : j) q.position.z += dx;
@@ -97,10 +107,13 @@ Series jittered(const Take& take, const std::vector<double>& times, float sigma,
 
 TEST(StressJitter, GaussianOneToFiveCentimetres) {
   STRESS_REQUIRE_TAKE(take, kComeHere);
-  const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
-  const Series control = replay(take, times);
   const double end = kStart + 2.0;
-  for (float sigma : {0.01f, 0.02f, 0.05f}) {
+  const std::vector<double> times = fixedTimes(replayedSeconds(take, end + 2.0), 1.0 / 30.0);
+  const Series control = replay(take, times);
+  // Under the sanitizers 2 cm (the bound of small jitter) and 5 cm (a noise burst: the kept state
+  // is put back when it ends, docs/robustness.md "Recovery from glitches").
+  const float sigmas[] = {0.01f, 0.02f, 0.05f};
+  for (float sigma : variants(sigmas, {1, 2})) {
     const Series s = jittered(take, times, sigma, end);
     const std::string name = "jitter sigma " + std::to_string(int(sigma * 100 + 0.5f)) + " cm";
     print(name.c_str(), s);
@@ -121,9 +134,9 @@ TEST(StressJitter, GaussianOneToFiveCentimetres) {
 
 TEST(StressTracking, JointsNotTrackedForThirtyFramesThenBack) {
   STRESS_REQUIRE_TAKE(take, kComeHere);
-  const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
-  const Series control = replay(take, times);
   const double end = kStart + 30.0 / 30.0;
+  const std::vector<double> times = fixedTimes(replayedSeconds(take, end + 2.0), 1.0 / 30.0);
+  const Series control = replay(take, times);
   struct Case {
     const char* name;
     std::vector<int> joints;
@@ -133,7 +146,7 @@ TEST(StressTracking, JointsNotTrackedForThirtyFramesThenBack) {
       {"both legs not tracked", {KneeL, AnkleL, FootL, KneeR, AnkleR, FootR}},
       {"whole body not tracked", {}},
   };
-  for (const Case& c : cases) {
+  for (const Case& c : variants(cases, {0, 2})) {  // sanitizers: some joints lost, and all of them
     const Series s = replay(take, times, [&](double t, Joints& j) {
       if (t < kStart || t >= end) return;
       if (c.joints.empty()) {
@@ -155,9 +168,9 @@ TEST(StressTracking, JointsNotTrackedForThirtyFramesThenBack) {
 
 TEST(StressBones, ZeroLengthAndReversedBones) {
   STRESS_REQUIRE_TAKE(take, kComeHere);
-  const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
-  const Series control = replay(take, times);
   const double end = kStart + 1.0;
+  const std::vector<double> times = fixedTimes(replayedSeconds(take, end + 2.0), 1.0 / 30.0);
+  const Series control = replay(take, times);
   auto reflect = [](drape_joint& child, const drape_joint& parent) {
     child.position = drape_vec3{2 * parent.position.x - child.position.x, 2 * parent.position.y - child.position.y,
                                 2 * parent.position.z - child.position.z};
@@ -173,7 +186,9 @@ TEST(StressBones, ZeroLengthAndReversedBones) {
       {"reversed forearms", [&](Joints& j) { reflect(j[WristL], j[ElbowL]), reflect(j[WristR], j[ElbowR]); }},
       {"reversed thighs (knees above hips)", [&](Joints& j) { reflect(j[KneeL], j[HipL]), reflect(j[KneeR], j[HipR]); }},
   };
-  for (const Case& c : cases) {
+  // Under the sanitizers one zero-length bone pair among normal bones, every bone of zero length at
+  // once, and reversed bones (the thighs: their ellipsoids then cross the torso and the shirt's hem).
+  for (const Case& c : variants(cases, {0, 2, 4})) {
     const Series s = replay(take, times, [&](double t, Joints& j) {
       if (t >= kStart && t < end) c.f(j);
     });
@@ -259,20 +274,25 @@ TEST(StressBadInput, RefusedInputLeavesTheStateBitIdentical) {
 TEST(StressBodyShape, BmiFifteenToFortyFiveHeightOneToTwoPointTwo) {
   STRESS_REQUIRE_TAKE(take, kBalance);
   const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
-  for (float h : {1.0f, 1.6f, 2.2f})
-    for (float bmi : {15.0f, 25.0f, 45.0f}) {
-      Dressing setup;
-      setup.set_shape = true;
-      drape_body_shape_init(&setup.shape);
-      setup.shape.height_m = h;
-      setup.shape.weight_kg = bmi * h * h;
-      const Series s = replay(take, times, nullptr, setup, 2);
-      char name[64];
-      std::snprintf(name, sizeof name, "height %.1f m, BMI %.0f", h, bmi);
-      print(name, s);
-      expectHealthy(s, name);
-      EXPECT_LE(s.maxP99(0, 1e9), 1.3f) << name;  // measured worst 0.96 (2.2 m, BMI 25)
-    }
+  struct Shape {
+    float h, bmi;
+  };
+  const Shape shapes[] = {{1.0f, 15.0f}, {1.0f, 25.0f}, {1.0f, 45.0f}, {1.6f, 15.0f}, {1.6f, 25.0f},
+                          {1.6f, 45.0f}, {2.2f, 15.0f}, {2.2f, 25.0f}, {2.2f, 45.0f}};
+  for (const Shape& shape : variants(shapes, {0, 8})) {  // sanitizers: the smallest and the largest body
+    const float h = shape.h, bmi = shape.bmi;
+    Dressing setup;
+    setup.set_shape = true;
+    drape_body_shape_init(&setup.shape);
+    setup.shape.height_m = h;
+    setup.shape.weight_kg = bmi * h * h;
+    const Series s = replay(take, times, nullptr, setup, 2);
+    char name[64];
+    std::snprintf(name, sizeof name, "height %.1f m, BMI %.0f", h, bmi);
+    print(name, s);
+    expectHealthy(s, name);
+    EXPECT_LE(s.maxP99(0, 1e9), 1.3f) << name;  // measured worst 0.96 (2.2 m, BMI 25)
+  }
 }
 
 TEST(StressBodyShape, ShapeChangedUnderTheGarment) {
@@ -305,7 +325,7 @@ TEST(StressBodyShape, ShapeChangedUnderTheGarment) {
 
 TEST(StressClothParams, ComplianceAndMassAtExtremes) {
   STRESS_REQUIRE_TAKE(take, kComeHere);
-  const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
+  const std::vector<double> times = fixedTimes(replayedSeconds(take, kStart + 3.0), 1.0 / 30.0);
   const Series control = replay(take, times, nullptr, Dressing(), 2);
   struct Case {
     const char* name;
@@ -321,7 +341,9 @@ TEST(StressClothParams, ComplianceAndMassAtExtremes) {
       // 1 m/N on 10 kg/m2: the cloth sags under its own weight (measured worst 340 %), by design.
       {"all compliances 1, 10 kg/m2", 1.0f, 1.0f, 1.0f, 10.0f, 4.5f},
   };
-  for (const Case& c : cases) {
+  // Under the sanitizers both ends of both ranges and both kinds of bound: inextensible and
+  // lightest, stiff in stretch only, softest and heaviest.
+  for (const Case& c : variants(cases, {0, 2, 5})) {
     Dressing setup;
     setup.set_desc = setup.set_cloth = true;
     drape_garment_desc_init(&setup.desc);
@@ -376,9 +398,9 @@ void loop(double minutes) {
 // (GarmentSim::poseJumped). Before both, particles reached 45 m/s, P99 332 %, no recovery.
 TEST(StressPose, UpsideDownSkeletonForOneSecondThenBack) {
   STRESS_REQUIRE_TAKE(take, kComeHere);
-  const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
-  const Series control = replay(take, times);
   const double end = kStart + 1.0;
+  const std::vector<double> times = fixedTimes(replayedSeconds(take, end + 2.0), 1.0 / 30.0);
+  const Series control = replay(take, times);
   const Series s = replay(take, times, [&](double t, Joints& j) {
     if (t < kStart || t >= end) return;
     const drape_vec3 c = j[SpineBase].position;
