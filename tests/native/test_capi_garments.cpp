@@ -292,6 +292,48 @@ TEST(CApiGarments, CallerMeshAndObjGarments) {
   EXPECT_TRUE(allFinite(snapshot(patch)));
 }
 
+// A body-shape change with garments on refits them through the C ABI too: an OBJ suit (let out
+// on the rest body, cut_from_dressed) and a template keep their handles and vertex counts, their
+// rest shapes follow the taller body, and they step on finite.
+TEST(CApiGarments, BodyShapeChangeRefitsObjAndTemplateGarments) {
+  DRAPE_REQUIRE_SHARED(path, kSuit);
+  ContextPtr ctx = makeContext();
+  drape_garment* suit = nullptr;
+  ASSERT_OK(drape_context_add_garment_obj_file(ctx.get(), path.c_str(), nullptr, nullptr, nullptr, &suit));
+  drape_garment* shirt = addTShirt(ctx.get(), 400);
+  for (int i = 0; i < 5; ++i) ASSERT_OK(pushAndStep(ctx.get(), i));
+  auto restHeight = [](drape_garment* g, uint32_t n) {
+    std::vector<drape_vec3> rest(n);
+    EXPECT_EQ(drape_garment_read_rest_positions(g, rest.data(), n), DRAPE_OK);
+    float lo = 1e9f, hi = -1e9f;
+    for (const drape_vec3& v : rest) lo = std::min(lo, v.y), hi = std::max(hi, v.y);
+    return hi - lo;
+  };
+  uint32_t n_suit = 0, n_shirt = 0;
+  ASSERT_OK(drape_garment_get_mesh_size(suit, &n_suit, nullptr));
+  ASSERT_OK(drape_garment_get_mesh_size(shirt, &n_shirt, nullptr));
+  const float suit_before = restHeight(suit, n_suit), shirt_before = restHeight(shirt, n_shirt);
+  drape_body_shape tall;
+  ASSERT_OK(drape_body_shape_init(&tall));
+  tall.height_m = 2.0f;
+  tall.weight_kg = 100.0f;
+  ASSERT_OK(drape_context_set_body_shape(ctx.get(), &tall));
+  uint32_t n = 0;
+  ASSERT_OK(drape_garment_get_mesh_size(suit, &n, nullptr));
+  EXPECT_EQ(n, n_suit);
+  ASSERT_OK(drape_garment_get_mesh_size(shirt, &n, nullptr));
+  EXPECT_EQ(n, n_shirt);
+  EXPECT_GT(restHeight(suit, n_suit), 1.1f * suit_before);
+  EXPECT_GT(restHeight(shirt, n_shirt), 1.1f * shirt_before);
+  for (int i = 5; i < 20; ++i) ASSERT_OK(pushAndStep(ctx.get(), i));
+  EXPECT_TRUE(allFinite(snapshot(suit)));
+  EXPECT_TRUE(allFinite(snapshot(shirt)));
+  drape_garment_accuracy a;
+  a.struct_size = sizeof(a);
+  ASSERT_OK(drape_garment_measure(suit, &a));
+  EXPECT_LT(a.p99_stretch, 0.6f);
+}
+
 TEST(CApiGarments, BuffersTooSmallAreLeftUntouched) {
   ContextPtr ctx = makeContext();
   drape_garment* g = addTShirt(ctx.get(), 400);
