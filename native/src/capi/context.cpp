@@ -107,9 +107,12 @@ drape_result Context::setShape(const BodyShapeInput& in, std::string& err) {
   if (!validateShapeInput(in, err, &nonfinite))
     return nonfinite ? DRAPE_ERROR_NONFINITE : DRAPE_ERROR_OUT_OF_RANGE;
   const ResolvedShape before = shape_;
-  shape_ = resolveShape(in);
-  body_->setShape(shape_);
-  restBody_.reset();
+  auto useShape = [this](const ResolvedShape& shape) {
+    shape_ = shape;
+    body_->setShape(shape_);
+    restBody_.reset();  // rebuilt for the shape when next asked for
+  };
+  useShape(resolveShape(in));
   // Garments are refitted to the new body (GarmentSim::refitted, docs/garments.md "Body shape
   // changes"): all of them or, when one cannot be dressed on it, none and the old shape back.
   std::vector<std::unique_ptr<GarmentSim>> refits;
@@ -120,9 +123,7 @@ drape_result Context::setShape(const BodyShapeInput& in, std::string& err) {
     std::string why;
     refits.push_back(garments_[i]->refitted(restBody(), restEllipsoids(), restEllipsoidChains(), why));
     if (!refits.back()) {
-      shape_ = before;
-      body_->setShape(shape_);
-      restBody_.reset();
+      useShape(before);
       err = "garment " + std::to_string(i) + " could not be dressed on the new body (" + why +
             "); the previous shape is kept";
       return DRAPE_ERROR_INVALID_ARGUMENT;

@@ -243,10 +243,7 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
         return nullptr;
       g->topology_ = std::move(cut);
       g->mesh_.positions = shape;
-      for (size_t k = 0; k < g->mesh_.pinned.size(); ++k) {
-        const RingPose& r = body_rest.rings()[static_cast<size_t>(g->mesh_.pin_ring[k])];
-        g->mesh_.pin_local[k] = r.frame.transpose() * (shape[g->mesh_.pinned[k]] - r.centre);
-      }
+      pinOffsetsFromPositions(body_rest, g->mesh_);
       g->pinTargets(body_rest, g->seen_pins_);
       g->solver_ = makeSolver(solver, g->topology_);
       if (!g->setParams(params, err) || !g->solver_->reset(shape, err)) return nullptr;
@@ -292,10 +289,7 @@ std::unique_ptr<GarmentSim> GarmentSim::refitted(const BodyModel& body_rest,
   skin.place(body_rest, mesh.positions);
   // Attachments keep their ring; their offset from it follows the carried cut (the ring grew or
   // shrank with the body, so the old offset in metres would put the pin inside or off the body).
-  for (size_t k = 0; k < mesh.pinned.size(); ++k) {
-    const RingPose& r = body_rest.rings()[static_cast<size_t>(mesh.pin_ring[k])];
-    mesh.pin_local[k] = r.frame.transpose() * (mesh.positions[mesh.pinned[k]] - r.centre);
-  }
+  pinOffsetsFromPositions(body_rest, mesh);
   std::unique_ptr<GarmentSim> g = create(mesh, o.topology, kind_, params_, o.dress_time_s, body_rest,
                                          rest_ellipsoids, ellipsoid_chains, err, true);
   if (g) g->origin_ = origin_;

@@ -108,8 +108,9 @@ class GarmentSim {
   // context's new rest body, same ring layout) by ring skinning, then dressed there as create()
   // dresses with cut_from_dressed: the skinning scales the garment's gap to the body with the
   // girths, so where the new body's ellipsoids bulge past it the cut is let out instead of
-  // stretched (on a 1.2 m / BMI 16 body that took the P99 stretch from 0.44 to 0.27). The cut carried is always the one create() got, bound to the rest body of that time,
-  // so refitting back and forth does not drift. Same particles, triangles, attachments, solver
+  // stretched (on a 1.2 m / BMI 16 body that took the P99 stretch from 0.44 to 0.27). The cut
+  // carried is always the one create() got, bound to the rest body of that time, so refitting
+  // back and forth does not drift. Same particles, triangles, attachments, solver
   // and parameters; it sits on the new rest pose until its first step places it on the tracked
   // body (as a new garment does). Null + err when the dressing fails. docs/garments.md, "Body
   // shape changes".

@@ -187,13 +187,7 @@ class Builder {
     return false;
   }
 
-  void finishPins(GarmentMesh& m) const {
-    m.pin_local.clear();
-    for (size_t i = 0; i < m.pinned.size(); ++i) {
-      const RingPose& r = body_.rings()[static_cast<size_t>(m.pin_ring[i])];
-      m.pin_local.push_back(r.frame.transpose() * (m.positions[m.pinned[i]] - r.centre));
-    }
-  }
+  void finishPins(GarmentMesh& m) const { pinOffsetsFromPositions(body_, m); }
 
  private:
   uint32_t add(GarmentMesh& m, const Vec3& x) {
@@ -501,6 +495,14 @@ void weldShortEdges(GarmentMesh& m, float tol) {
 }
 
 }  // namespace
+
+void pinOffsetsFromPositions(const BodyModel& body, GarmentMesh& m) {
+  m.pin_local.resize(m.pinned.size());
+  for (size_t i = 0; i < m.pinned.size(); ++i) {
+    const RingPose& r = body.rings()[static_cast<size_t>(m.pin_ring[i])];
+    m.pin_local[i] = r.frame.transpose() * (m.positions[m.pinned[i]] - r.centre);
+  }
+}
 
 const char* garmentKindName(GarmentKind kind) {
   switch (kind) {

@@ -39,4 +39,8 @@ bool makeGarmentTemplate(const BodyModel& body_in_rest_pose, const GarmentTempla
 
 const char* garmentKindName(GarmentKind kind);
 
+// pin_local from where the pinned particles are: each one's offset in its ring's frame on `body`
+// (positions and pin_ring set; pin_local is resized).
+void pinOffsetsFromPositions(const BodyModel& body, GarmentMesh& m);
+
 }  // namespace drape

@@ -61,7 +61,6 @@ void RingSkin::bind(const BodyModel& body, const std::vector<Vec3>& points, floa
 
 void RingSkin::bind(const BodyModel& layout, const std::vector<RingPose>& rings, const std::vector<Vec3>& points,
                     float blend_m) {
-  const BodyModel& body = layout;
   primary_.assign(points.size(), RingBinding{});
   blend_.clear();
   weight_.clear();
@@ -70,7 +69,7 @@ void RingSkin::bind(const BodyModel& layout, const std::vector<RingPose>& rings,
   for (size_t v = 0; v < points.size(); ++v) {
     cands.clear();
     for (int c = 0; c < kChainCount; ++c) {
-      const int first = body.chainFirstRing(Chain(c)), n = body.chainRingCount(Chain(c));
+      const int first = layout.chainFirstRing(Chain(c)), n = layout.chainRingCount(Chain(c));
       for (int i = 0; i + 1 < n; ++i) cands.push_back(bindToSegment(rings, c, first + i, points[v]));
     }
     primary_[v] = *std::min_element(cands.begin(), cands.end(),

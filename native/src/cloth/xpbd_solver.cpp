@@ -1,5 +1,7 @@
 #include "cloth/xpbd_solver.h"
 
+#include "common/cpu.h"
+
 #include <chrono>
 #include <cmath>
 #include <utility>
@@ -201,18 +203,13 @@ __attribute__((target("avx"))) void projectBatchesAvx(Vec4* x, const uint32_t* A
     }
   }
 }
-
-bool haveAvx() {
-  static const bool avx = __builtin_cpu_supports("avx");
-  return avx;
-}
 #endif
 
 template <bool kTether>
 void project(Vec4* x, const uint32_t* A, const uint32_t* B, const float* rest, const float* inv_w,
              size_t m, float scale) {
 #if DRAPE_XPBD_AVX
-  if (haveAvx()) return projectBatchesAvx<kTether>(x, A, B, rest, inv_w, m, scale);
+  if (cpuHasAvx()) return projectBatchesAvx<kTether>(x, A, B, rest, inv_w, m, scale);
 #endif
   projectBatches<kTether>(x, A, B, rest, inv_w, m, scale);
 }

@@ -2,6 +2,8 @@
 // chosen at run time). docs/collision.md, "Eight particles at once".
 #include "proxies/collision_internal.h"
 
+#include "common/cpu.h"
+
 #include <limits>
 
 #if (defined(__GNUC__) || defined(__clang__)) && (defined(__x86_64__) || defined(__i386__))
@@ -13,10 +15,6 @@ using namespace collision_internal;
 
 #if (defined(__GNUC__) || defined(__clang__)) && (defined(__x86_64__) || defined(__i386__))
 namespace {
-bool cpuHasAvx() {
-  static const bool avx = __builtin_cpu_supports("avx");
-  return avx;
-}
 // The 8 lanes of v.
 struct Lanes {
   alignas(32) float v[8];
@@ -61,9 +59,11 @@ __attribute__((target("avx"))) bool EllipsoidCollider::collideEight(Eigen::Vecto
                                                                      bool grouped, CollisionStats& st) const {
   // More ellipsoids than the grid takes (broad phase off): one particle at a time.
   if (!cpuHasAvx() || shapes_.size() > static_cast<size_t>(kMaxGridEllipsoids)) return false;
-  const bool swept = p.continuous && previous != nullptr;
+  // Every lane that takes part has a finite start position when `previous` is given (the others
+  // go the one-particle way), so the swept test and friction are the same for all of them.
+  const bool cont = p.continuous && previous != nullptr;
+  const bool friction = previous != nullptr && (p.static_friction > 0.0f || p.kinetic_friction > 0.0f);
   const bool use_grid = p.broad_phase && grid_;
-  const bool any_friction = p.static_friction > 0.0f || p.kinetic_friction > 0.0f;
   Lanes X, Y, Z, X0, Y0, Z0, LOX, LOY, LOZ, HIX, HIY, HIZ;
   const uint64_t* allowed[8];
   Vec3 start[8];
@@ -72,7 +72,7 @@ __attribute__((target("avx"))) bool EllipsoidCollider::collideEight(Eigen::Vecto
   Vec3 lo = Vec3::Constant(std::numeric_limits<float>::infinity()), hi = -lo;
   for (int j = 0; j < 8; ++j) {
     const size_t i = begin + static_cast<size_t>(j);
-    if (!mayTouch(positions, previous, i, swept)) continue;  // as collide()'s particle loop
+    if (!mayTouch(positions, previous, i, cont)) continue;  // as collide()'s particle loop
     const Vec3 x = positions[i].head<3>();
     allowed[j] = grouped ? &allowed_[static_cast<size_t>(particle_masks_[i]) * (kMaxGridEllipsoids / 64)] : nullptr;
     const Vec3 x0 = previous ? Vec3(previous[i].head<3>()) : x;
@@ -86,7 +86,7 @@ __attribute__((target("avx"))) bool EllipsoidCollider::collideEight(Eigen::Vecto
     start[j] = x0;
     X.v[j] = x.x(), Y.v[j] = x.y(), Z.v[j] = x.z();
     X0.v[j] = x0.x(), Y0.v[j] = x0.y(), Z0.v[j] = x0.z();
-    const Vec3 l = swept ? x.cwiseMin(x0) : x, h = swept ? x.cwiseMax(x0) : x;
+    const Vec3 l = cont ? x.cwiseMin(x0) : x, h = cont ? x.cwiseMax(x0) : x;
     LOX.v[j] = l.x(), LOY.v[j] = l.y(), LOZ.v[j] = l.z();
     HIX.v[j] = h.x(), HIY.v[j] = h.y(), HIZ.v[j] = h.z();
     lo = lo.cwiseMin(l);
@@ -96,9 +96,6 @@ __attribute__((target("avx"))) bool EllipsoidCollider::collideEight(Eigen::Vecto
   }
   Candidates c;
   if (active == 0 || !gather(lo, hi, use_grid, grouped ? joint_allowed : nullptr, c)) return true;
-  const bool has_prev = previous != nullptr;
-  const bool cont = p.continuous && has_prev;
-  const bool friction = has_prev && any_friction;
   const __m256 lox = _mm256_load_ps(LOX.v), loy = _mm256_load_ps(LOY.v), loz = _mm256_load_ps(LOZ.v);
   const __m256 hix = _mm256_load_ps(HIX.v), hiy = _mm256_load_ps(HIY.v), hiz = _mm256_load_ps(HIZ.v);
   const __m256 x0x = _mm256_load_ps(X0.v), x0y = _mm256_load_ps(Y0.v), x0z = _mm256_load_ps(Z0.v);
