@@ -183,8 +183,10 @@ int expectSignsAgree(const TriangleBvh& bvh, const std::vector<Vec3>& P,
                   << sd << " winding " << windingNumber(P, I, points[i]) << " feature "
                   << static_cast<int>(h.feature);
   }
-  EXPECT_GT(inside, 500) << what << ": too few inside points to test the sign";
-  EXPECT_GT(outside, 500) << what;
+  // 500 each way, or a sixth of fewer than 3 000 probes (the sanitizers' quarter sets).
+  const int sixth = std::min(500, static_cast<int>(points.size()) / 6);
+  EXPECT_GT(inside, sixth) << what << ": too few inside points to test the sign";
+  EXPECT_GT(outside, sixth) << what;
   std::printf("  %s: %d inside, %d outside; %d with a buried closest point (%d of them signed wrong)\n",
               what, inside, outside, buried, buried_disagree);
   return buried;
@@ -234,10 +236,14 @@ TEST(TriangleBvh, SignedDistanceExactOnMeshWithoutSelfIntersection) {
   ASSERT_GT(signedVolume(P, I), 0.0);
   TriangleBvh bvh;
   ASSERT_TRUE(bvh.build(P, I));
-  const std::vector<Vec3> points = probePoints(P, I, 4000, 19);
+  // Under the sanitizers the first quarter of the same probes (each repeats the same query against
+  // the winding number over every triangle, the ASan cost); each feature still needs the same
+  // share of them (20 of 4 000).
+  const std::vector<Vec3> points = probePoints(P, I, test::repeatsUnderSanitizers(4000, 4), 19);
   int features[7] = {};
   for (const Vec3& p : points) ++features[static_cast<int>(bvh.closest(p).feature)];
-  for (int f = 0; f < 7; ++f) EXPECT_GT(features[f], 20) << "feature " << f << " barely exercised";
+  const int per_feature = 20 * static_cast<int>(points.size()) / 4000;
+  for (int f = 0; f < 7; ++f) EXPECT_GT(features[f], per_feature) << "feature " << f << " barely exercised";
   EXPECT_EQ(expectSignsAgree(bvh, P, I, points, "bumpy sphere"), 0);
 }
 
@@ -245,9 +251,12 @@ TEST(TriangleBvh, SignedDistanceAgreesWithWindingNumber) {
   const BodyModel body = restBody();
   TriangleBvh bvh;
   ASSERT_TRUE(bvh.build(body.positions(), body.indices()));
-  const auto points = probePoints(body.positions(), body.indices(), 3000, 23);
+  // Under the sanitizers the first quarter of the same probes: each probe repeats the same
+  // closest-point query and winding number, and 750 still hold both signs and probes whose closest
+  // point is on buried surface (3 under ASan, 10 of 3 000 in release).
+  const auto points = probePoints(body.positions(), body.indices(), test::repeatsUnderSanitizers(3000, 4), 23);
   const int buried = expectSignsAgree(bvh, body.positions(), body.indices(), points, "rest pose");
-  EXPECT_LT(buried, 60) << "more than 2 % of probes near buried surface";
+  EXPECT_LT(buried, static_cast<int>(points.size()) / 50) << "more than 2 % of probes near buried surface";
 }
 
 TEST(TriangleBvh, RefitAfterPoseChangeAgreesWithBruteForce) {
@@ -264,16 +273,20 @@ TEST(TriangleBvh, RefitAfterPoseChangeAgreesWithBruteForce) {
   EXPECT_EQ(bvh.nodeCount(), nodes);
   EXPECT_EQ(bvh.vertexPseudoNormals().data(), normals_storage);  // refitted in place
 
-  const std::vector<Vec3> points = probePoints(P, I, 2000, 31);
+  // Under the sanitizers a quarter of each probe set (the first ones of the same sequences): the
+  // refitted tree is the same for every probe, and each further probe repeats the same queries
+  // against brute force and the winding number (every triangle, the cost under ASan).
+  const std::vector<Vec3> points = probePoints(P, I, test::repeatsUnderSanitizers(2000, 4), 31);
   for (size_t i = 0; i < points.size(); ++i)
     EXPECT_NEAR(bvh.closest(points[i]).distance, bruteDistance(P, I, points[i]), 1e-6f) << i;
-  EXPECT_LT(expectSignsAgree(bvh, P, I, probePoints(P, I, 3000, 37), "moved pose, refitted"), 60);
+  const std::vector<Vec3> signs = probePoints(P, I, test::repeatsUnderSanitizers(3000, 4), 37);
+  EXPECT_LT(expectSignsAgree(bvh, P, I, signs, "moved pose, refitted"), static_cast<int>(signs.size()) / 50);
 
   // build() with the same topology takes the refit path too.
   body.update(restPose(body.shape(), 60.0f));
   ASSERT_TRUE(bvh.build(body.positions(), body.indices()));
   EXPECT_EQ(bvh.vertexPseudoNormals().data(), normals_storage);
-  const std::vector<Vec3> more = probePoints(body.positions(), I, 500, 41);
+  const std::vector<Vec3> more = probePoints(body.positions(), I, test::repeatsUnderSanitizers(500, 4), 41);
   for (const Vec3& p : more)
     EXPECT_NEAR(bvh.closest(p).distance, bruteDistance(body.positions(), I, p), 1e-6f);
 }
@@ -317,7 +330,14 @@ TEST(MeshCollider, PushesEveryParticleOutAndBruteForceAgrees) {
   const auto& I = body.indices();
   TriangleBvh bvh;
   ASSERT_TRUE(bvh.build(P, I));
-  const std::vector<Vec3> points = probePoints(P, I, 3000, 53);
+  // Under the sanitizers the first quarter of the same particles: collideWithMesh runs on all of
+  // them at once either way, and the per-particle checks below (brute force, winding number) only
+  // repeat; 750 still include pinned, inside and gap particles and ones that need several passes
+  // (the one particle of 3 000 left near buried surface is not among them: that is this test's
+  // classification of the result, its projection the same code as any other's). The count bounds
+  // are the same fractions of the particles.
+  const std::vector<Vec3> points = probePoints(P, I, test::repeatsUnderSanitizers(3000, 4), 53);
+  const int count = static_cast<int>(points.size());
   const float margin = 0.005f;
   std::vector<Eigen::Vector4f> particles;
   uint32_t expected_contacts = 0;
@@ -333,7 +353,7 @@ TEST(MeshCollider, PushesEveryParticleOutAndBruteForceAgrees) {
   EXPECT_EQ(s.contacts, expected_contacts);
   EXPECT_EQ(sb.contacts, expected_contacts);
   EXPECT_EQ(s.passes, sb.passes);
-  EXPECT_GT(s.contacts, 800u);
+  EXPECT_GT(s.contacts, static_cast<uint32_t>(count * 4 / 15));  // 800 of 3 000
   EXPECT_GE(s.passes, s.contacts);
 
   int inside_before = 0, buried = 0, gap = 0;
@@ -366,11 +386,11 @@ TEST(MeshCollider, PushesEveryParticleOutAndBruteForceAgrees) {
     ADD_FAILURE() << "particle " << i << " at " << p.transpose() << ": signed distance " << sd
                   << " after " << single.passes << " passes";
   }
-  EXPECT_GT(inside_before, 500);
+  EXPECT_GT(inside_before, count / 6);  // 500 of 3 000
   std::printf("  %u contacts, %u projections; left within the margin: %d near buried surface, "
               "%d in gaps narrower than 2 margin (of %zu particles)\n",
               s.contacts, s.passes, buried, gap, particles.size());
-  EXPECT_LT(buried + gap, 60) << "more than 2 % of particles not pushed out";
+  EXPECT_LT(buried + gap, count / 50) << "more than 2 % of particles not pushed out";
 
   // Nothing is left to do except for those particles.
   EXPECT_LE(collideWithMesh(bvh, particles.data(), particles.size(), margin - 2e-5f).contacts,

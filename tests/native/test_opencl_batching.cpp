@@ -4,6 +4,7 @@
 // real Kinect take. Plus the launch count per frame, AUTO's mix of CPU and device garments, and
 // drape_step_contexts' argument checks (those run without a device).
 #include "capi_test_support.h"
+#include "sanitizer_scale.h"
 #include "test_data.h"
 
 #if DRAPE_HAVE_OPENCL
@@ -102,6 +103,15 @@ bool sameBits(const std::vector<float>& a, const std::vector<float>& b) {
 
 constexpr float kDt = 1.0f / 30.0f;
 
+// Garment sizes: under the sanitizers half of each (still all different, and on either side of
+// AUTO's threshold where a test uses one). Making a template is most of these tests' ASan time
+// (62 % of LaunchesPerFrameDoNotGrowWithGarments), while what they check - the same bits batched
+// and one by one, the launches per frame - is the same for every garment of the one-work-group
+// path (up to 4 096 particles; the large-garment tests below keep their size).
+constexpr uint32_t sized(uint32_t particles) {
+  return drape::test::kSanitizedBuild ? particles / 2 : particles;
+}
+
 #if DRAPE_HAVE_OPENCL
 // Batching on for the scope (restored after: other tests run with the default, on).
 struct Batching {
@@ -157,7 +167,7 @@ void expectSameRuns(const std::vector<std::vector<float>>& a, const std::vector<
 
 TEST(OpenClBatching, GarmentsOfOneContextMatchOneByOneBitForBit) {
   DRAPE_LOAD_TAKE(take, 12);
-  const std::vector<uint32_t> sizes = {400, 800, 1200};
+  const std::vector<uint32_t> sizes = {sized(400), sized(800), sized(1200)};
   World one = makeWorld(sizes, DRAPE_BACKEND_OPENCL);
   DRAPE_REQUIRE_DEVICE_WORLD(one);
   EXPECT_EQ(backendInfo(one.ctx.get()).opencl_garments, 3u);
@@ -174,10 +184,10 @@ TEST(OpenClBatching, GarmentsOfOneContextMatchOneByOneBitForBit) {
 
 TEST(OpenClBatching, ContextsSteppedTogetherMatchSeparateStepsBitForBit) {
   DRAPE_LOAD_TAKE(take, 12);
-  World a = makeWorld({600}, DRAPE_BACKEND_OPENCL), b = makeWorld({500, 900}, DRAPE_BACKEND_OPENCL);
+  World a = makeWorld({sized(600)}, DRAPE_BACKEND_OPENCL), b = makeWorld({sized(500), sized(900)}, DRAPE_BACKEND_OPENCL);
   DRAPE_REQUIRE_DEVICE_WORLD(a);
   const auto separate = runTake({&a, &b}, take, false);
-  World c = makeWorld({600}, DRAPE_BACKEND_OPENCL), d = makeWorld({500, 900}, DRAPE_BACKEND_OPENCL);
+  World c = makeWorld({sized(600)}, DRAPE_BACKEND_OPENCL), d = makeWorld({sized(500), sized(900)}, DRAPE_BACKEND_OPENCL);
   const auto together = runTake({&c, &d}, take, true);
   expectSameRuns(together, separate);
 }
@@ -199,11 +209,11 @@ TEST(OpenClBatching, LaunchesPerFrameDoNotGrowWithGarments) {
     }
     return per_frame;
   };
-  const std::vector<uint32_t> four = {500, 600, 700, 800};
+  const std::vector<uint32_t> four = {sized(500), sized(600), sized(700), sized(800)};
   for (const float inertia : {1.0f, -1.0f}) {
     SCOPED_TRACE(inertia < 0.0f ? "default inertia (rigid carry each frame)" : "inertia 1 (no carry)");
     const uint64_t per_garment = inertia < 0.0f ? 2 : 1;  // the frame (+ the carry)
-    World one = makeWorld({500}, DRAPE_BACKEND_OPENCL, 0, inertia);
+    World one = makeWorld({sized(500)}, DRAPE_BACKEND_OPENCL, 0, inertia);
     DRAPE_REQUIRE_DEVICE_WORLD(one);
     World batched = makeWorld(four, DRAPE_BACKEND_OPENCL, 0, inertia);
     World by_one = makeWorld(four, DRAPE_BACKEND_OPENCL, 0, inertia);
@@ -215,9 +225,9 @@ TEST(OpenClBatching, LaunchesPerFrameDoNotGrowWithGarments) {
 
 TEST(OpenClBatching, TwoContextsCostOneLaunchPerFrame) {
   DRAPE_LOAD_TAKE(take, 8);
-  World a = makeWorld({500, 700}, DRAPE_BACKEND_OPENCL, 0, 1.0f);
+  World a = makeWorld({sized(500), sized(700)}, DRAPE_BACKEND_OPENCL, 0, 1.0f);
   DRAPE_REQUIRE_DEVICE_WORLD(a);
-  World b = makeWorld({600}, DRAPE_BACKEND_OPENCL, 0, 1.0f);
+  World b = makeWorld({sized(600)}, DRAPE_BACKEND_OPENCL, 0, 1.0f);
   drape_context* both[2] = {a.ctx.get(), b.ctx.get()};
   uint64_t last = 0;
   for (size_t f = 0; f < take.joints.size(); ++f) {
@@ -234,14 +244,14 @@ TEST(OpenClBatching, TwoContextsCostOneLaunchPerFrame) {
 // world matches the one-by-one run bit for bit (the CPU garment included).
 TEST(OpenClBatching, MixedCpuAndDeviceGarmentsUnderAuto) {
   DRAPE_LOAD_TAKE(take, 10);
-  const std::vector<uint32_t> sizes = {400, 1200, 1500};
-  World batched = makeWorld(sizes, DRAPE_BACKEND_AUTO, 1000);
+  const std::vector<uint32_t> sizes = {sized(400), sized(1200), sized(1500)};
+  World batched = makeWorld(sizes, DRAPE_BACKEND_AUTO, sized(1000));
   DRAPE_REQUIRE_DEVICE_WORLD(batched);
   const drape_backend_info i = backendInfo(batched.ctx.get());
   EXPECT_EQ(i.opencl_garments, 2u);
   EXPECT_EQ(i.cpu_garments, 1u);
   const auto together = runTake({&batched}, take, false);
-  World one = makeWorld(sizes, DRAPE_BACKEND_AUTO, 1000);
+  World one = makeWorld(sizes, DRAPE_BACKEND_AUTO, sized(1000));
   std::vector<std::vector<float>> by_one;
   {
     Batching off(false);
@@ -249,7 +259,7 @@ TEST(OpenClBatching, MixedCpuAndDeviceGarmentsUnderAuto) {
   }
   expectSameRuns(together, by_one);
   // And the CPU garment is the CPU's own answer: the same garment alone in a CPU world.
-  World cpu = makeWorld({400}, DRAPE_BACKEND_CPU);
+  World cpu = makeWorld({sized(400)}, DRAPE_BACKEND_CPU);
   const auto cpu_run = runTake({&cpu}, take, false);
   const size_t n0 = cpu_run.back().size();
   EXPECT_TRUE(std::memcmp(cpu_run.back().data(), together.back().data(), n0 * sizeof(float)) == 0);

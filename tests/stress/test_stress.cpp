@@ -2,7 +2,7 @@
 // perturbation applied to what the host pushes through the C ABI. Each scenario is compared with
 // the undisturbed run of the same take at the same frame times. Bounds: docs/robustness.md.
 // Under the sanitizers (preset asan) every scenario runs with every assertion, on less of the same
-// work: a 400-particle garment, the variants that cover its code paths (`variants`), the take up
+// work: a 200-particle garment (400 for the scenarios about the cloth: clothDressing()), the variants that cover its code paths (`variants`), the take up
 // to the end of its last checked window (`replayedSeconds`), every other frame measured (`replay`).
 #include "stress_support.h"
 
@@ -281,7 +281,7 @@ TEST(StressBodyShape, BmiFifteenToFortyFiveHeightOneToTwoPointTwo) {
                           {1.6f, 45.0f}, {2.2f, 15.0f}, {2.2f, 25.0f}, {2.2f, 45.0f}};
   for (const Shape& shape : variants(shapes, {0, 8})) {  // sanitizers: the smallest and the largest body
     const float h = shape.h, bmi = shape.bmi;
-    Dressing setup;
+    Dressing setup = clothDressing();
     setup.set_shape = true;
     drape_body_shape_init(&setup.shape);
     setup.shape.height_m = h;
@@ -297,7 +297,7 @@ TEST(StressBodyShape, BmiFifteenToFortyFiveHeightOneToTwoPointTwo) {
 
 TEST(StressBodyShape, ShapeChangedUnderTheGarment) {
   STRESS_REQUIRE_TAKE(take, kBalance);
-  Scene scene;
+  Scene scene(clothDressing());
   const std::vector<double> times = fixedTimes(take.duration(), 1.0 / 30.0);
   const float shapes[][2] = {{1.0f, 15.0f}, {2.2f, 45.0f}, {1.7f, 22.5f}};
   for (size_t i = 0; i < times.size(); ++i) {
@@ -326,7 +326,7 @@ TEST(StressBodyShape, ShapeChangedUnderTheGarment) {
 TEST(StressClothParams, ComplianceAndMassAtExtremes) {
   STRESS_REQUIRE_TAKE(take, kComeHere);
   const std::vector<double> times = fixedTimes(replayedSeconds(take, kStart + 3.0), 1.0 / 30.0);
-  const Series control = replay(take, times, nullptr, Dressing(), 2);
+  const Series control = replay(take, times, nullptr, clothDressing(), 2);
   struct Case {
     const char* name;
     float stretch, shear, bend, density;
@@ -344,7 +344,7 @@ TEST(StressClothParams, ComplianceAndMassAtExtremes) {
   // Under the sanitizers both ends of both ranges and both kinds of bound: inextensible and
   // lightest, stiff in stretch only, softest and heaviest.
   for (const Case& c : variants(cases, {0, 2, 5})) {
-    Dressing setup;
+    Dressing setup = clothDressing();
     setup.set_desc = setup.set_cloth = true;
     drape_garment_desc_init(&setup.desc);
     setup.desc.area_density = c.density;
