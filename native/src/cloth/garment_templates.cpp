@@ -147,20 +147,20 @@ class Builder {
   // normal (Newton steps on the implicit), which keeps neighbours apart (a radial projection
   // from the centre would squeeze them together).
   void pushOut(GarmentMesh& m, float clear) const {
+    const std::vector<Inflated> inflated = inflate(clear);
     for (int pass = 0; pass < 16; ++pass) {
       bool moved = false;
       for (Vec3& x : m.positions) {
-        for (const Ellipsoid& e : ell_) {
-          const Vec3 r = e.radii + Vec3::Constant(clear);
-          const Mat3 toUnit = r.cwiseInverse().asDiagonal() * e.rotation.transpose();
+        for (const Inflated& e : inflated) {
+          if (!e.mayContain(x)) continue;  // outside the box: f >= 0 below, nothing to do
           for (int it = 0; it < 20; ++it) {
-            const Vec3 q = toUnit * (x - e.centre);
+            const Vec3 q = e.to_unit * (x - e.centre);
             const float f = q.squaredNorm() - 1.001f;
             if (f >= 0.0f) break;
-            const Vec3 g = 2.0f * (toUnit.transpose() * q);
+            const Vec3 g = 2.0f * (e.to_unit.transpose() * q);
             const float g2 = g.squaredNorm();
             if (g2 < 1e-12f) {
-              x += e.rotation.col(0) * 1e-3f;
+              x += e.axis0 * 1e-3f;
               continue;
             }
             x -= (f - 1e-4f) / g2 * g;
@@ -174,20 +174,51 @@ class Builder {
     // the hip axis until outside all of them.
     const Vec3 down = -hip_.f.col(1);
     for (Vec3& x : m.positions) {
-      for (int step = 0; step < 100 && insideAny(x, clear); ++step) x += 0.002f * down;
+      for (int step = 0; step < 100 && insideAny(inflated, x); ++step) x += 0.002f * down;
     }
   }
 
-  bool insideAny(const Vec3& x, float clear) const {
+  void finishPins(GarmentMesh& m) const { pinOffsetsFromPositions(body_, m); }
+
+ private:
+  // An ellipsoid inflated by the clearance, with what the push-out tests need computed once per
+  // call (they were recomputed per particle and pass: most of a template's build time).
+  struct Inflated {
+    Vec3 centre;
+    Mat3 to_unit;       // S^-1 R^T of the inflated radii
+    Vec3 axis0;         // the rotation's first column (the nudge off a degenerate gradient)
+    Vec3 box_min, box_max;  // AABB of the ellipsoid scaled by 1.01: |q|^2 > 1.0201 outside it
+    bool mayContain(const Vec3& x) const {
+      return (x.array() >= box_min.array()).all() && (x.array() <= box_max.array()).all();
+    }
+  };
+  std::vector<Inflated> inflate(float clear) const {
+    std::vector<Inflated> out;
+    out.reserve(ell_.size());
     for (const Ellipsoid& e : ell_) {
+      Inflated f;
       const Vec3 r = e.radii + Vec3::Constant(clear);
-      const Vec3 q = (r.cwiseInverse().asDiagonal() * e.rotation.transpose()) * (x - e.centre);
-      if (q.squaredNorm() < 1.0f) return true;
+      f.centre = e.centre;
+      f.to_unit = r.cwiseInverse().asDiagonal() * e.rotation.transpose();
+      f.axis0 = e.rotation.col(0);
+      // Half extent along world axis i: sqrt(sum_j (R_ij r_j)^2); 1.01 keeps every point the
+      // Newton loop would move (|q|^2 < 1.001) well inside, whatever the rounding.
+      const Vec3 half = 1.01f * Mat3(e.rotation * r.asDiagonal()).rowwise().norm();
+      f.box_min = e.centre - half;
+      f.box_max = e.centre + half;
+      out.push_back(f);
+    }
+    return out;
+  }
+  static bool insideAny(const std::vector<Inflated>& inflated, const Vec3& x) {
+    for (const Inflated& e : inflated) {
+      if (!e.mayContain(x)) continue;
+      if ((e.to_unit * (x - e.centre)).squaredNorm() < 1.0f) return true;
     }
     return false;
   }
 
-  void finishPins(GarmentMesh& m) const { pinOffsetsFromPositions(body_, m); }
+ public:
 
  private:
   uint32_t add(GarmentMesh& m, const Vec3& x) {
