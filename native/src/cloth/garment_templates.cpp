@@ -151,16 +151,17 @@ class Builder {
     for (int pass = 0; pass < 16; ++pass) {
       bool moved = false;
       for (Vec3& x : m.positions) {
-        for (const Inflated& e : inflated) {
-          if (!e.mayContain(x)) continue;  // outside the box: f >= 0 below, nothing to do
+        for (const Inflated& in : inflated) {
+          if (!in.mayContain(x)) continue;  // outside the box: f >= 0 below, nothing to do
+          const Ellipsoid& e = in.e;
           for (int it = 0; it < 20; ++it) {
-            const Vec3 q = e.to_unit * (x - e.centre);
+            const Vec3 q = e.toUnit(x);
             const float f = q.squaredNorm() - 1.001f;
             if (f >= 0.0f) break;
             const Vec3 g = 2.0f * (e.to_unit.transpose() * q);
             const float g2 = g.squaredNorm();
             if (g2 < 1e-12f) {
-              x += e.axis0 * 1e-3f;
+              x += e.rotation.col(0) * 1e-3f;
               continue;
             }
             x -= (f - 1e-4f) / g2 * g;
@@ -181,46 +182,36 @@ class Builder {
   void finishPins(GarmentMesh& m) const { pinOffsetsFromPositions(body_, m); }
 
  private:
-  // An ellipsoid inflated by the clearance, with what the push-out tests need computed once per
-  // call (they were recomputed per particle and pass: most of a template's build time).
+  // An ellipsoid inflated by the clearance (refresh() gives its to_unit and bounds), computed once
+  // per call: per particle and pass they were most of a template's build time. The box is the
+  // bounds scaled by 1.01 about the centre: outside it |q|^2 > 1.0201, so the Newton loop (which
+  // acts below 1.001) and insideAny have nothing to do there, whatever the rounding.
   struct Inflated {
-    Vec3 centre;
-    Mat3 to_unit;       // S^-1 R^T of the inflated radii
-    Vec3 axis0;         // the rotation's first column (the nudge off a degenerate gradient)
-    Vec3 box_min, box_max;  // AABB of the ellipsoid scaled by 1.01: |q|^2 > 1.0201 outside it
+    Ellipsoid e;
+    Vec3 box_min, box_max;
     bool mayContain(const Vec3& x) const {
       return (x.array() >= box_min.array()).all() && (x.array() <= box_max.array()).all();
     }
   };
   std::vector<Inflated> inflate(float clear) const {
-    std::vector<Inflated> out;
-    out.reserve(ell_.size());
-    for (const Ellipsoid& e : ell_) {
-      Inflated f;
-      const Vec3 r = e.radii + Vec3::Constant(clear);
-      f.centre = e.centre;
-      f.to_unit = r.cwiseInverse().asDiagonal() * e.rotation.transpose();
-      f.axis0 = e.rotation.col(0);
-      // Half extent along world axis i: sqrt(sum_j (R_ij r_j)^2); 1.01 keeps every point the
-      // Newton loop would move (|q|^2 < 1.001) well inside, whatever the rounding.
-      const Vec3 half = 1.01f * Mat3(e.rotation * r.asDiagonal()).rowwise().norm();
-      f.box_min = e.centre - half;
-      f.box_max = e.centre + half;
-      out.push_back(f);
+    std::vector<Inflated> out(ell_.size());
+    for (size_t k = 0; k < ell_.size(); ++k) {
+      Inflated& f = out[k];
+      f.e = ell_[k];
+      f.e.radii += Vec3::Constant(clear);
+      f.e.refresh();
+      const Vec3 half = 1.01f * (f.e.bounds_max - f.e.centre);
+      f.box_min = f.e.centre - half;
+      f.box_max = f.e.centre + half;
     }
     return out;
   }
   static bool insideAny(const std::vector<Inflated>& inflated, const Vec3& x) {
-    for (const Inflated& e : inflated) {
-      if (!e.mayContain(x)) continue;
-      if ((e.to_unit * (x - e.centre)).squaredNorm() < 1.0f) return true;
-    }
+    for (const Inflated& f : inflated)
+      if (f.mayContain(x) && f.e.toUnit(x).squaredNorm() < 1.0f) return true;
     return false;
   }
 
- public:
-
- private:
   uint32_t add(GarmentMesh& m, const Vec3& x) {
     m.positions.push_back(x);
     return static_cast<uint32_t>(m.positions.size() - 1);
