@@ -63,7 +63,7 @@ EllipsoidCollider* ColliderMotion::beginSpan(int s0, int s1, int n) {
   if (t1 == 1.0f) {
     b_ = end_;
   } else {
-    for (int k = 0; k < count_; ++k) b_[k] = interpolateEllipsoid(start_[k], end_[k], t1);
+    for (int k = 0; k < count_; ++k) b_[k] = interpolateEllipsoidPose(start_[k], end_[k], t1);
   }
   collider_->setEllipsoids(a_.data(), b_.data(), count_, margin_);
   return collider_;

@@ -252,6 +252,13 @@ void XpbdSolver::refreshCompliance() {
   inv_w_h2_ = -1.0f;  // recompute inv_w at the next substep
   distance_.inv_w.resize(distance_.a.size());
   tethers_.inv_w.resize(tethers_.a.size());
+  // Inverse masses never change after construction (reset, transform and mutablePositions keep
+  // w), so their pair sums are computed once here.
+  for (Batches* b : {&distance_, &tethers_}) {
+    b->w_ab.resize(b->a.size());
+    for (size_t k = 0; k < b->a.size(); ++k)
+      b->w_ab[k] = x_[b->a[k]].w() + (b == &tethers_ ? 0.0f : x_[b->b[k]].w());
+  }
   const float by_kind[4] = {params_.stretch_compliance, params_.shear_compliance,
                             params_.bend_compliance, 0.0f};
   for (size_t k = 0; k < distance_kind_.size(); ++k)
@@ -404,11 +411,15 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
   const float inv_h2 = 1.0f / (h * h);
   if (inv_h2 != inv_w_h2_) {  // h changed (or params): refresh 1 / (w_a + w_b + alpha~)
     inv_w_h2_ = inv_h2;
+    // Host frame times vary (a Kinect's by a few per cent), so h and this refresh change nearly
+    // every step: one contiguous pass, no gathers (w_a + w_b first, as the sum was written).
     for (Batches* b : {&distance_, &tethers_}) {
+      const float* w_ab = b->w_ab.data();
+      const float* comp = b->compliance.data();
+      float* inv_w = b->inv_w.data();
       for (size_t k = 0; k < b->a.size(); ++k) {
-        const float wb = b == &tethers_ ? 0.0f : x[b->b[k]].w();
-        const float wsum = x[b->a[k]].w() + wb + b->compliance[k] * inv_h2;
-        b->inv_w[k] = wsum > 0.0f ? 1.0f / wsum : 0.0f;
+        const float wsum = w_ab[k] + comp[k] * inv_h2;
+        inv_w[k] = wsum > 0.0f ? 1.0f / wsum : 0.0f;
       }
     }
   }

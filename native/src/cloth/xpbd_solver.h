@@ -125,6 +125,8 @@ class XpbdSolver {
   struct Batches {
     std::vector<uint32_t> a, b;
     std::vector<float> rest, compliance;
+    std::vector<float> w_ab;   // w_a + w_b (w_a for tethers): fixed, so a new h costs one
+                               // division per constraint and no gathers
     std::vector<float> inv_w;  // 1 / (w_a + w_b + compliance / h^2), for inv_w_h2_; 0 = inert
     std::vector<uint32_t> group_offsets{0};
   };

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 namespace drape {
@@ -99,7 +100,7 @@ inline Vec3 entryPoint(const Vec3& q0, float q0sq, const Vec3& q1) {
 
 }  // namespace
 
-Ellipsoid interpolateEllipsoid(const Ellipsoid& a, const Ellipsoid& b, float t) {
+Ellipsoid interpolateEllipsoidPose(const Ellipsoid& a, const Ellipsoid& b, float t) {
   Ellipsoid e;
   e.centre = a.centre + t * (b.centre - a.centre);
   e.radii = a.radii + t * (b.radii - a.radii);
@@ -107,6 +108,11 @@ Ellipsoid interpolateEllipsoid(const Ellipsoid& a, const Ellipsoid& b, float t) 
   qa.normalize();
   qb.normalize();
   e.rotation = qa.slerp(t, qb).toRotationMatrix();
+  return e;
+}
+
+Ellipsoid interpolateEllipsoid(const Ellipsoid& a, const Ellipsoid& b, float t) {
+  Ellipsoid e = interpolateEllipsoidPose(a, b, t);
   e.refresh();
   return e;
 }
@@ -129,7 +135,11 @@ void EllipsoidCollider::setEllipsoids(const Ellipsoid* start, const Ellipsoid* e
     shapes_.clear();
     return;
   }
-  margin_ = (margin_m >= 0.0f && std::isfinite(margin_m)) ? margin_m : 0.0f;
+  const float margin = (margin_m >= 0.0f && std::isfinite(margin_m)) ? margin_m : 0.0f;
+  // What the last call built for its end ellipsoids is valid for this call's start ones at the
+  // same margin (bit-for-bit equal inputs, checked per ellipsoid below).
+  const size_t reusable = std::memcmp(&margin, &margin_, sizeof margin) == 0 ? shapes_.size() : 0;
+  margin_ = margin;
   shapes_.resize(static_cast<size_t>(count));
   quick_.resize(static_cast<size_t>(count));
   constexpr float kInf = std::numeric_limits<float>::infinity();
@@ -148,11 +158,27 @@ void EllipsoidCollider::setEllipsoids(const Ellipsoid* start, const Ellipsoid* e
     return isFinite(mn) && isFinite(mx) && isFinite(f.to_unit.rowwise().sum());
   };
 
+  auto same = [](const auto& a, const auto& b) { return std::memcmp(a.data(), b.data(), sizeof(a)) == 0; };
   for (int k = 0; k < count; ++k) {
     Shape& s = shapes_[static_cast<size_t>(k)];
     Vec3 start_radii, start_min, start_max;
-    const bool ok = build(end[k], s.end, s.radii, s.end_min, s.end_max) &&
-                    build(start[k], s.start, start_radii, start_min, start_max);
+    bool start_ok;
+    if (static_cast<size_t>(k) < reusable && same(start[k].centre, s.end_in_centre) &&
+        same(start[k].radii, s.end_in_radii) && same(start[k].rotation, s.end_in_rotation)) {
+      s.start = s.end;  // the previous end frame, built from this very ellipsoid
+      start_min = s.end_built_min;
+      start_max = s.end_built_max;
+      start_ok = s.end_built_ok;
+    } else {
+      start_ok = build(start[k], s.start, start_radii, start_min, start_max);
+    }
+    s.end_built_ok = build(end[k], s.end, s.radii, s.end_built_min, s.end_built_max);
+    s.end_in_centre = end[k].centre;
+    s.end_in_radii = end[k].radii;
+    s.end_in_rotation = end[k].rotation;
+    s.end_min = s.end_built_min;
+    s.end_max = s.end_built_max;
+    const bool ok = s.end_built_ok && start_ok;
     s.rotation = end[k].rotation;
     if (!ok) {  // never matches: empty boxes
       s.end_min = s.swept_min = Vec3::Constant(kInf);

@@ -12,6 +12,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace drape {
@@ -50,6 +51,9 @@ struct CollisionStats {
 // The ellipsoid at fraction t of a substep: centre and radii interpolated linearly, rotation by
 // quaternion slerp (shortest arc), then refresh().
 Ellipsoid interpolateEllipsoid(const Ellipsoid& a, const Ellipsoid& b, float t);
+// The same centre, radii and rotation without refresh() (to_unit and bounds left as they were
+// default-constructed): all that EllipsoidCollider::setEllipsoids reads.
+Ellipsoid interpolateEllipsoidPose(const Ellipsoid& a, const Ellipsoid& b, float t);
 
 class EllipsoidCollider {
  public:
@@ -65,7 +69,9 @@ class EllipsoidCollider {
   // particle and the surface, i.e. the cloth thickness:
   // radii + margin, see docs/collision.md for the error of that approximation), and the grid is
   // rebuilt. Allocates only when `count` grows; call once per substep. count <= 0 or null
-  // pointers: no ellipsoids.
+  // pointers: no ellipsoids. A start ellipsoid equal (bit for bit) to the previous call's end
+  // ellipsoid of the same index, at the same margin, reuses what that call computed for it (the
+  // usual case: consecutive substeps share it), with the same result as computing it again.
   void setEllipsoids(const Ellipsoid* start, const Ellipsoid* end, int count,
                      float margin_m = kDefaultMargin);
 
@@ -107,6 +113,14 @@ class EllipsoidCollider {
     float inside_tol2 = 1.0f;          // |q|^2 below this: inside by more than the tolerance
     float graze = 0.0f;                // swept chords shallower than this (unit space) ignored
     int smallest_axis = 0;
+    // The end ellipsoid as setEllipsoids received it and what was built from it (its box kept
+    // even when the build failed and end_min/end_max were emptied): the next call's start when
+    // that is the same ellipsoid.
+    Vec3 end_in_centre = Vec3::Constant(std::numeric_limits<float>::quiet_NaN());
+    Vec3 end_in_radii = Vec3::Zero();
+    Mat3 end_in_rotation = Mat3::Zero();
+    Vec3 end_built_min, end_built_max;
+    bool end_built_ok = false;
   };
   // Hot-path copy of a shape in 16-byte lanes (w = 0): what every narrow test reads, so a test
   // is a few 4-wide multiply-adds. Shape keeps the rest for the (rarer) responses.

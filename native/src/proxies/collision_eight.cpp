@@ -69,6 +69,10 @@ __attribute__((target("avx"))) bool EllipsoidCollider::collideEight(Eigen::Vecto
   Vec3 start[8];
   int active = 0;  // bit j: lane j takes part in the batched pass 0
   uint64_t joint_allowed[kMaxGridEllipsoids / 64] = {};
+  // Lane j's collision mask in byte j: lane j may touch ellipsoid k when its byte shares a bit
+  // with groups_[k] (what allowed_ tabulates, setGroups), so one AND and one byte compare give
+  // the lanes allowed for k. Lanes not taking part keep 0.
+  uint64_t lane_masks = 0;
   Vec3 lo = Vec3::Constant(std::numeric_limits<float>::infinity()), hi = -lo;
   for (int j = 0; j < 8; ++j) {
     const size_t i = begin + static_cast<size_t>(j);
@@ -91,8 +95,10 @@ __attribute__((target("avx"))) bool EllipsoidCollider::collideEight(Eigen::Vecto
     HIX.v[j] = h.x(), HIY.v[j] = h.y(), HIZ.v[j] = h.z();
     lo = lo.cwiseMin(l);
     hi = hi.cwiseMax(h);
-    if (allowed[j])
+    if (allowed[j]) {
       for (int w = 0; w < words_; ++w) joint_allowed[w] |= allowed[j][w];
+      lane_masks |= static_cast<uint64_t>(particle_masks_[i]) << (8 * j);
+    }
   }
   Candidates c;
   if (active == 0 || !gather(lo, hi, use_grid, grouped ? joint_allowed : nullptr, c)) return true;
@@ -108,9 +114,12 @@ __attribute__((target("avx"))) bool EllipsoidCollider::collideEight(Eigen::Vecto
     const int k = ks[n];
     const Quick& qk = quick_[static_cast<size_t>(k)];
     int lanes = active;
-    if (grouped)
-      for (int j = 0; j < 8; ++j)
-        if (((lanes >> j) & 1) && !((allowed[j][k >> 6] >> (k & 63)) & 1u)) lanes &= ~(1 << j);
+    if (grouped) {
+      const uint64_t shared = lane_masks & (0x0101010101010101ull * groups_[static_cast<size_t>(k)]);
+      const int none = _mm_movemask_epi8(_mm_cmpeq_epi8(_mm_cvtsi64_si128(static_cast<long long>(shared)),
+                                                         _mm_setzero_si128())) & 0xFF;
+      lanes &= ~none;
+    }
     const __m256 px = _mm256_load_ps(X.v), py = _mm256_load_ps(Y.v), pz = _mm256_load_ps(Z.v);
     // The swept box (fixed per particle) against the ellipsoid's swept box, or the end position
     // as pass 0 saw it (lo = hi = x then) in the end box.
@@ -160,7 +169,17 @@ __attribute__((target("avx"))) bool EllipsoidCollider::collideEight(Eigen::Vecto
   for (int j = 0; j < 8; ++j) {
     if (!((moved >> j) & 1)) continue;
     Vec3 x(X.v[j], Y.v[j], Z.v[j]);
-    settle(x, nullptr, p, use_grid, allowed[j], st);
+    // The joint candidates narrowed to this lane's groups: where they cover x, settle tests the
+    // same ellipsoids in the same order as after a gather of its own (collision.cpp, settle).
+    Candidates mine = c;
+    if (grouped) {
+      if (mine.all) {
+        mine.allowed = allowed[j];
+      } else {
+        for (int w = 0; w < words_; ++w) mine.mask[w] &= allowed[j][w];
+      }
+    }
+    settle(x, &mine, p, use_grid, allowed[j], st);
     const size_t i = begin + static_cast<size_t>(j);
     if (x != Vec3(positions[i].head<3>())) positions[i].head<3>() = x;
   }
