@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace drape {
@@ -116,7 +117,11 @@ class XpbdSolver {
  private:
   // pin_t: fraction of the step at the substep end; collider: this substep's, or null.
   // span_prev: positions at the start of the collision span (the substep start when stride 1).
-  void substep(float h, float pin_t, const EllipsoidCollider* collider, const Eigen::Vector4f* span_prev);
+  // predicted: the prediction already ran (fused into the previous substep's last loop);
+  // predict_next: run the next substep's prediction in this one's last loop (same step, same h),
+  // with each particle's position before it copied to capture[i] when capture is not null.
+  void substep(float h, float pin_t, const EllipsoidCollider* collider, const Eigen::Vector4f* span_prev,
+               bool predicted, bool predict_next, Eigen::Vector4f* capture);
   // Constraint storage for the SIMD kernels: every colour group padded to a multiple of kLanes
   // with dummy constraints on the dummy particle x_[n] (w = 0, never read back), so a batch of
   // kLanes constraints shares no particle and needs no tail loop. Stretch, shear and bend are
@@ -128,6 +133,9 @@ class XpbdSolver {
     std::vector<float> w_ab;   // w_a + w_b (w_a for tethers): fixed, so a new h costs one
                                // division per constraint and no gathers
     std::vector<float> inv_w;  // 1 / (w_a + w_b + compliance / h^2), for inv_w_h2_; 0 = inert
+    // [begin, end) runs of entries with compliance > 0: the only ones a new h changes (the
+    // others, rigid constraints and padding, are set once by refreshCompliance)
+    std::vector<std::pair<uint32_t, uint32_t>> compliant;
     std::vector<uint32_t> group_offsets{0};
   };
   void buildBatches();
