@@ -74,7 +74,7 @@ foreach(path "drape_version" "recording" "format" "layout" "frames" "rejected_fr
              "stages_ms|proxies" "proxies|count" "proxies|rule" "proxies|frames_measured"
              "proxies|fit_p95_mm" "proxies|fit_max_mm" "proxies|outside_fraction"
              "stages_ms|cloth" "stages_ms|integrate" "stages_ms|collide" "stages_ms|frame" "particles"
-             "garment|kind" "garment|source" "garment|solver" "garment|substep_hz" "garment|triangles"
+             "garment|kind" "garment|source" "garment|solver" "garment|substep_hz" "garment|iterations" "garment|triangles"
              "garment|edges" "garment|attached" "garment|frames_stepped" "garment|max_stretch"
              "garment|p99_stretch" "garment|proxy_inside" "garment|body_penetration_mm|p99"
              "garment|body_penetration_mm|max" "garment|deeper_than_2mm" "garment|frames_measured"

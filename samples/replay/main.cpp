@@ -172,6 +172,7 @@ int run(int argc, char** argv) {
     drape_garment_desc_init(&gdesc);
     gdesc.solver = opt.solver;
     if (opt.substeps != 0) cloth.substep_hz = 30.0f * static_cast<float>(opt.substeps);
+    if (opt.iterations != 0) cloth.iterations = opt.iterations;
     else if (opt.solver == DRAPE_SOLVER_MASS_SPRING) cloth.substep_hz = kMassSpringSubstepHz;
     // A frame a little longer than 1/30 s must not hit the per-step cap (which would lengthen
     // every substep instead of adding some).
@@ -293,6 +294,7 @@ int run(int argc, char** argv) {
     st.garment_kind = st.garment_from_obj ? opt.garment_obj : replay::garmentKindName(opt.garment_kind);
     st.solver = opt.solver;
     st.substep_hz = actual.substep_hz;
+    st.iterations = actual.iterations;
     st.particles = garment_vertices;
     st.garment_triangles = garment_index_count / 3;
     st.attached = gs.attached;

@@ -253,6 +253,13 @@ bool parseOptions(int argc, const char* const* argv, Options& o, std::string& er
                 "] (substeps per 1/30 s frame, e.g. --substeps 10 for 300 Hz)";
         return false;
       }
+    } else if (name == "--iterations") {
+      if (!takeValue()) return false;
+      if (!parseUint(value, 1, 64, o.iterations)) {
+        error = "--iterations '" + value +
+                "' is not a whole number in [1, 64] (XPBD constraint passes per substep; 1 is the method)";
+        return false;
+      }
     } else if (name == "--measure-every" || name == "--garment-every") {
       if (!takeValue()) return false;
       if (!parseUint(value, 0, 0xffffffffUL, o.measure_every)) {
@@ -315,10 +322,15 @@ bool parseOptions(int argc, const char* const* argv, Options& o, std::string& er
     }
   }
   // Garment options that the chosen garment would silently ignore are mistakes.
-  if (o.garment_none && (o.particles != 0 || o.solver_given || o.substeps != 0 || o.measure_given)) {
+  if (o.garment_none && (o.particles != 0 || o.solver_given || o.substeps != 0 || o.iterations != 0 ||
+                         o.measure_given)) {
     error = std::string(o.particles != 0 ? "--particles" : o.solver_given ? "--solver"
-                        : o.substeps != 0 ? "--substeps" : "--measure-every") +
+                        : o.substeps != 0 ? "--substeps" : o.iterations != 0 ? "--iterations" : "--measure-every") +
             " has no effect with --garment none; drop it or choose a garment";
+    return false;
+  }
+  if (o.iterations != 0 && o.solver == DRAPE_SOLVER_MASS_SPRING) {
+    error = "--iterations has no effect with --solver massspring (it has no constraint passes); drop it";
     return false;
   }
   if (!o.render && (o.render_every_given || o.render_options_given)) {
@@ -390,6 +402,9 @@ std::string helpText() {
       "                        ~3 kHz, so it runs at 2880 Hz unless --substeps is given)\n"
       "  --substeps N          cloth substeps per 1/30 s frame, in [1, 666]: substep_hz = 30 * N\n"
       "                        (default 10 = 300 Hz for xpbd, 96 = 2880 Hz for massspring)\n"
+      "  --iterations N        XPBD constraint passes per substep, in [1, 64] (default 1, the\n"
+      "                        method; with --substeps, e.g. --substeps 160 --iterations 4 is\n"
+      "                        drape-bench's converged reference)\n"
       "  --measure-every N     measure the garment's accuracy (stretch, ellipsoid and body\n"
       "                        penetration; ~1 ms per 1 000 particles) every N frames (default 1;\n"
       "                        0 = never). Alias: --garment-every\n"

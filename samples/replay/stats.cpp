@@ -173,11 +173,17 @@ std::string statsJson(const ReplayStats& s) {
     w.key("source").value(s.garment_from_obj ? "obj" : "template");
     w.key("solver").value(s.solver == DRAPE_SOLVER_MASS_SPRING ? "massspring" : "xpbd");
     w.key("substep_hz").value(s.substep_hz);
+    if (s.solver == DRAPE_SOLVER_MASS_SPRING) {
+      w.key("iterations").null();
+    } else {
+      w.key("iterations").value(s.iterations);
+    }
   } else {
     w.key("kind").value("none");
     w.key("source").value("none");
     w.key("solver").null();
     w.key("substep_hz").null();
+    w.key("iterations").null();
   }
   w.key("triangles").value(s.garment_triangles);
   w.key("edges").value(static_cast<int64_t>(s.stretch.edgeCount()));
@@ -246,10 +252,13 @@ std::string summaryText(const ReplayStats& s, const std::string& obj_dir, const 
         s.proxy_count, s.proxy_rule == DRAPE_PROXY_RULE_PAPER ? "paper" : "drape", median(s.body_to_proxy_p95),
         median(s.proxy_to_body_p95), s.body_to_proxy_p95.size());
   if (s.has_garment) {
-    appendf(o, "garment     %s (%s), %s solver at %.0f Hz, %u particles (%u attached), %u triangles\n",
+    const std::string passes = s.solver != DRAPE_SOLVER_MASS_SPRING && s.iterations > 1
+                                   ? " x " + std::to_string(s.iterations) + " passes"
+                                   : std::string();
+    appendf(o, "garment     %s (%s), %s solver at %.0f Hz%s, %u particles (%u attached), %u triangles\n",
         s.garment_kind.c_str(), s.garment_from_obj ? "OBJ" : "template",
-        s.solver == DRAPE_SOLVER_MASS_SPRING ? "massspring" : "xpbd", s.substep_hz, s.particles, s.attached,
-        s.garment_triangles);
+        s.solver == DRAPE_SOLVER_MASS_SPRING ? "massspring" : "xpbd", s.substep_hz, passes.c_str(), s.particles,
+        s.attached, s.garment_triangles);
     appendf(o, "backend     %s%s%s%s\n", s.backend.c_str(), s.device.empty() ? "" : (" on " + s.device).c_str(),
         s.backend_fallback.empty() ? "" : " (OpenCL not used: ", s.backend_fallback.empty() ? "" : (s.backend_fallback + ")").c_str());
     appendf(o, "stretch     max %.2f %%, P99 %.2f %% (%zu edges x %zu frames pooled)\n", 100.0 * s.stretch.max(),

@@ -65,6 +65,7 @@ struct ReplayStats {
   // "opencl", the OpenCL device's name ("" on the CPU) and why OpenCL was asked for and not used.
   std::string backend = "cpu", device, backend_fallback;
   double substep_hz = 0.0;         // drape_garment_get_params after adding
+  uint32_t iterations = 0;         // the same: XPBD passes per substep
   uint32_t particles = 0;          // garment vertex count
   uint32_t garment_triangles = 0;
   uint32_t attached = 0;
