@@ -413,16 +413,6 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
   const Vec4 wind(p.wind.x(), p.wind.y(), p.wind.z(), 0.0f);
   const float h_drag = h * p.drag;
   const float max_speed2 = p.max_speed > 0.0f ? p.max_speed * p.max_speed : 0.0f;
-  // The speed clamp. Its exact test is a 4-lane sum per particle; while every component is below
-  // 0.57 max_speed (3 * 0.57^2 = 0.975 < 1, room for the rounding) |v| is surely below
-  // max_speed and the test, which would say so, is skipped: the same result, mostly without it.
-  const Eigen::Array4f below = Eigen::Array4f::Constant(0.57f * p.max_speed);
-  auto clampSpeed = [&](Vec4& v) DRAPE_XPBD_INLINE {
-    if (max_speed2 > 0.0f && !(v.array().abs() < below).all()) {
-      const float s2 = v.squaredNorm();
-      if (s2 > max_speed2) v *= p.max_speed / std::sqrt(s2);
-    }
-  };
   // Particle i's prediction from its velocity v (xi = its position now).
   auto predict = [&](size_t i, const Vec4& xi, Vec4 v) DRAPE_XPBD_INLINE {
     prev[i] = xi;
@@ -431,7 +421,10 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
       return;
     }
     v += hg + h_drag * (wind - v);
-    clampSpeed(v);
+    if (max_speed2 > 0.0f) {
+      const float s2 = v.squaredNorm();
+      if (s2 > max_speed2) v *= p.max_speed / std::sqrt(s2);
+    }
     vel[i] = v;
     x[i] = xi + h * v;
   };
@@ -486,7 +479,10 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
   const float scale = std::exp(-p.damping * h) / h;
   for (size_t i = 0; i < n; ++i) {
     Vec4 v = (x[i] - prev[i]) * scale;
-    clampSpeed(v);
+    if (max_speed2 > 0.0f) {
+      const float s2 = v.squaredNorm();
+      if (s2 > max_speed2) v *= p.max_speed / std::sqrt(s2);
+    }
     if (!predict_next) {
       vel[i] = v;
       continue;
