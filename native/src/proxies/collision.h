@@ -158,6 +158,10 @@ class EllipsoidCollider {
   // first: pass 0's candidates for this particle, or null (then gathered where needed).
   void settle(Vec3& x, const Candidates* first, const CollisionParams& p, bool use_grid,
               const uint64_t* allowed, CollisionStats& stats) const;
+  // Particle i's collision-group row of allowed_ (grouped), or null.
+  const uint64_t* allowedFor(bool grouped, size_t i) const {
+    return grouped ? &allowed_[static_cast<size_t>(particle_masks_[i]) * (kMaxGridEllipsoids / 64)] : nullptr;
+  }
   // Whether particle i of collide() can touch anything (collision_internal.h).
   bool mayTouch(const Eigen::Vector4f* positions, const Eigen::Vector4f* previous, size_t i, bool swept) const;
   // collide() for particles [begin, begin + 8) (CollisionParams::batch8); false when the CPU has

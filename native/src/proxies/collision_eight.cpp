@@ -4,6 +4,7 @@
 
 #include "common/cpu.h"
 
+#include <cstring>
 #include <limits>
 
 #if (defined(__GNUC__) || defined(__clang__)) && (defined(__x86_64__) || defined(__i386__))
@@ -37,6 +38,51 @@ DRAPE_AVX_INLINE void unitSpace8(const Vec4* u, const Vec4& cen, __m256 px, __m2
 DRAPE_AVX_INLINE __m256 dot8(__m256 ax, __m256 ay, __m256 az, __m256 bx, __m256 by, __m256 bz) {
   return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ax, bx), _mm256_mul_ps(az, bz)), _mm256_mul_ps(ay, by));
 }
+// Eight consecutive Vec4s transposed to x, y, z, w lanes (lane j = v[j]): v[j] and v[j + 4]
+// share a 256-bit register, so the 4x4 transposes run in-lane (as the XPBD kernel's gather).
+DRAPE_AVX_INLINE void load8(const Vec4* v, __m256& x, __m256& y, __m256& z, __m256& w) {
+  __m256 r[4];
+  for (int i = 0; i < 4; ++i)
+    r[i] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(v[i].data())), _mm_loadu_ps(v[i + 4].data()), 1);
+  const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
+  const __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
+  x = _mm256_shuffle_ps(t0, t2, 0x44);
+  y = _mm256_shuffle_ps(t0, t2, 0xEE);
+  z = _mm256_shuffle_ps(t1, t3, 0x44);
+  w = _mm256_shuffle_ps(t1, t3, 0xEE);
+}
+// All three coordinates finite, per lane (v - v is 0 for finite v, NaN for NaN and infinities).
+DRAPE_AVX_INLINE __m256 finite8(__m256 x, __m256 y, __m256 z) {
+  const __m256 zero = _mm256_setzero_ps();
+  return _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(_mm256_sub_ps(x, x), zero, _CMP_EQ_OQ),
+                                     _mm256_cmp_ps(_mm256_sub_ps(y, y), zero, _CMP_EQ_OQ)),
+                       _mm256_cmp_ps(_mm256_sub_ps(z, z), zero, _CMP_EQ_OQ));
+}
+// All-ones lanes where bit j of `bits` is set.
+DRAPE_AVX_INLINE __m256 laneMask8(int bits) {
+  return _mm256_castsi256_ps(_mm256_setr_epi32(-(bits & 1), -((bits >> 1) & 1), -((bits >> 2) & 1),
+                                               -((bits >> 3) & 1), -((bits >> 4) & 1), -((bits >> 5) & 1),
+                                               -((bits >> 6) & 1), -((bits >> 7) & 1)));
+}
+// 0xFF in byte j where bit j of `bits` is set.
+inline uint64_t byteMask8(int bits) {
+  uint64_t m = 0;
+  for (int j = 0; j < 8; ++j)
+    if ((bits >> j) & 1) m |= uint64_t{0xFF} << (8 * j);
+  return m;
+}
+DRAPE_AVX_INLINE float hmin8(__m256 v) {
+  __m128 m = _mm_min_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
+  m = _mm_min_ps(m, _mm_movehl_ps(m, m));
+  m = _mm_min_ss(m, _mm_shuffle_ps(m, m, 1));
+  return _mm_cvtss_f32(m);
+}
+DRAPE_AVX_INLINE float hmax8(__m256 v) {
+  __m128 m = _mm_max_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
+  m = _mm_max_ps(m, _mm_movehl_ps(m, m));
+  m = _mm_max_ss(m, _mm_shuffle_ps(m, m, 1));
+  return _mm_cvtss_f32(m);
+}
 // lo <= mx and hi >= mn on each axis, per lane.
 DRAPE_AVX_INLINE __m256 boxes8(__m256 lox, __m256 loy, __m256 loz, __m256 hix, __m256 hiy, __m256 hiz,
                                const Vec4& mn, const Vec4& mx) {
@@ -64,48 +110,75 @@ __attribute__((target("avx"))) bool EllipsoidCollider::collideEight(Eigen::Vecto
   const bool cont = p.continuous && previous != nullptr;
   const bool friction = previous != nullptr && (p.static_friction > 0.0f || p.kinetic_friction > 0.0f);
   const bool use_grid = p.broad_phase && grid_;
-  Lanes X, Y, Z, X0, Y0, Z0, LOX, LOY, LOZ, HIX, HIY, HIZ;
-  const uint64_t* allowed[8];
-  Vec3 start[8];
-  int active = 0;  // bit j: lane j takes part in the batched pass 0
-  uint64_t joint_allowed[kMaxGridEllipsoids / 64] = {};
-  // Lane j's collision mask in byte j: lane j may touch ellipsoid k when its byte shares a bit
-  // with groups_[k] (what allowed_ tabulates, setGroups), so one AND and one byte compare give
-  // the lanes allowed for k. Lanes not taking part keep 0.
-  uint64_t lane_masks = 0;
-  Vec3 lo = Vec3::Constant(std::numeric_limits<float>::infinity()), hi = -lo;
-  for (int j = 0; j < 8; ++j) {
+  Lanes X, Y, Z, X0, Y0, Z0;
+  // The eight particles' positions (and start positions) loaded at once, lane j = particle
+  // begin + j, and collide()'s per-particle rejections (mayTouch) for all lanes together: the
+  // same comparisons, so the same lanes take part.
+  __m256 px, py, pz, pw, p0x, p0y, p0z, p0w;
+  load8(positions + begin, px, py, pz, pw);
+  if (previous) {
+    load8(previous + begin, p0x, p0y, p0z, p0w);
+  } else {
+    p0x = px, p0y = py, p0z = pz;
+  }
+  const __m256 zero = _mm256_setzero_ps();
+  const __m256 finite = finite8(px, py, pz);
+  const __m256 finite0 = previous ? finite8(p0x, p0y, p0z) : finite;
+  const Vec4 gmin = lift(grid_min_), gmax = lift(grid_max_);
+  __m256 touch = boxes8(px, py, pz, px, py, pz, gmin, gmax);  // x inside the grid's box
+  if (cont) {  // or its swept box overlaps it (finite start positions: plain min / max)
+    touch = _mm256_or_ps(touch, boxes8(_mm256_min_ps(px, p0x), _mm256_min_ps(py, p0y), _mm256_min_ps(pz, p0z),
+                                       _mm256_max_ps(px, p0x), _mm256_max_ps(py, p0y), _mm256_max_ps(pz, p0z),
+                                       gmin, gmax));
+  }
+  touch = _mm256_and_ps(_mm256_and_ps(touch, finite), _mm256_cmp_ps(pw, zero, _CMP_GT_OQ));
+  // A lane without a finite start position goes the one-particle way (its own mayTouch first:
+  // the swept box test above assumed finite start positions).
+  int scalar = previous ? (0xFF & ~_mm256_movemask_ps(finite0)) : 0;
+  const int active = _mm256_movemask_ps(touch) & ~scalar;  // bit j: lane j takes part in pass 0
+  while (scalar) {
+    const int j = __builtin_ctz(static_cast<unsigned>(scalar));
+    scalar &= scalar - 1;
     const size_t i = begin + static_cast<size_t>(j);
     if (!mayTouch(positions, previous, i, cont)) continue;  // as collide()'s particle loop
     const Vec3 x = positions[i].head<3>();
-    allowed[j] = grouped ? &allowed_[static_cast<size_t>(particle_masks_[i]) * (kMaxGridEllipsoids / 64)] : nullptr;
-    const Vec3 x0 = previous ? Vec3(previous[i].head<3>()) : x;
-    if (previous && !isFinite(x0)) {  // no start position: the one-particle path
-      Vec3 y = x;
-      resolveParticle(y, x, false, p, allowed[j], st);
-      if (y != x) positions[i].head<3>() = y;
-      continue;
-    }
-    active |= 1 << j;
-    start[j] = x0;
-    X.v[j] = x.x(), Y.v[j] = x.y(), Z.v[j] = x.z();
-    X0.v[j] = x0.x(), Y0.v[j] = x0.y(), Z0.v[j] = x0.z();
-    const Vec3 l = cont ? x.cwiseMin(x0) : x, h = cont ? x.cwiseMax(x0) : x;
-    LOX.v[j] = l.x(), LOY.v[j] = l.y(), LOZ.v[j] = l.z();
-    HIX.v[j] = h.x(), HIY.v[j] = h.y(), HIZ.v[j] = h.z();
-    lo = lo.cwiseMin(l);
-    hi = hi.cwiseMax(h);
-    if (allowed[j]) {
-      for (int w = 0; w < words_; ++w) joint_allowed[w] |= allowed[j][w];
-      lane_masks |= static_cast<uint64_t>(particle_masks_[i]) << (8 * j);
-    }
+    Vec3 y = x;
+    resolveParticle(y, x, false, p, allowedFor(grouped, i), st);
+    if (y != x) positions[i].head<3>() = y;
+  }
+  if (active == 0) return true;
+  const __m256 lox = cont ? _mm256_min_ps(px, p0x) : px, loy = cont ? _mm256_min_ps(py, p0y) : py,
+               loz = cont ? _mm256_min_ps(pz, p0z) : pz;
+  const __m256 hix = cont ? _mm256_max_ps(px, p0x) : px, hiy = cont ? _mm256_max_ps(py, p0y) : py,
+               hiz = cont ? _mm256_max_ps(pz, p0z) : pz;
+  _mm256_store_ps(X.v, px), _mm256_store_ps(Y.v, py), _mm256_store_ps(Z.v, pz);
+  _mm256_store_ps(X0.v, p0x), _mm256_store_ps(Y0.v, p0y), _mm256_store_ps(Z0.v, p0z);
+  // The joint box of the lanes taking part (the others set to an empty box first).
+  const __m256 on = laneMask8(active);
+  const __m256 inf = _mm256_set1_ps(std::numeric_limits<float>::infinity()), minf = _mm256_set1_ps(-std::numeric_limits<float>::infinity());
+  const Vec3 lo(hmin8(_mm256_blendv_ps(inf, lox, on)), hmin8(_mm256_blendv_ps(inf, loy, on)),
+                hmin8(_mm256_blendv_ps(inf, loz, on)));
+  const Vec3 hi(hmax8(_mm256_blendv_ps(minf, hix, on)), hmax8(_mm256_blendv_ps(minf, hiy, on)),
+                hmax8(_mm256_blendv_ps(minf, hiz, on)));
+  // Lane j's collision mask in byte j: lane j may touch ellipsoid k when its byte shares a bit
+  // with groups_[k] (what allowed_ tabulates, setGroups), so one AND and one byte compare give
+  // the lanes allowed for k. Lanes not taking part keep 0. The lanes' joint candidates are those
+  // of the union of their masks (allowed for m1 or m2 = allowed for m1 | m2).
+  uint64_t lane_masks = 0;
+  const uint64_t* joint_allowed = nullptr;
+  if (grouped) {
+    std::memcpy(&lane_masks, particle_masks_ + begin, sizeof lane_masks);
+    lane_masks &= byteMask8(active);
+    uint64_t m = lane_masks;
+    m |= m >> 32;
+    m |= m >> 16;
+    m |= m >> 8;
+    joint_allowed = &allowed_[static_cast<size_t>(m & 0xFFu) * (kMaxGridEllipsoids / 64)];
   }
   Candidates c;
-  if (active == 0 || !gather(lo, hi, use_grid, grouped ? joint_allowed : nullptr, c)) return true;
-  const __m256 lox = _mm256_load_ps(LOX.v), loy = _mm256_load_ps(LOY.v), loz = _mm256_load_ps(LOZ.v);
-  const __m256 hix = _mm256_load_ps(HIX.v), hiy = _mm256_load_ps(HIY.v), hiz = _mm256_load_ps(HIZ.v);
-  const __m256 x0x = _mm256_load_ps(X0.v), x0y = _mm256_load_ps(Y0.v), x0z = _mm256_load_ps(Z0.v);
-  const __m256 one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps();
+  if (!gather(lo, hi, use_grid, joint_allowed, c)) return true;
+  const __m256 x0x = p0x, x0y = p0y, x0z = p0z;
+  const __m256 one = _mm256_set1_ps(1.0f);
   int moved = 0;
   int ks[kMaxGridEllipsoids];
   int candidates = 0;
@@ -120,7 +193,8 @@ __attribute__((target("avx"))) bool EllipsoidCollider::collideEight(Eigen::Vecto
                                                          _mm_setzero_si128())) & 0xFF;
       lanes &= ~none;
     }
-    const __m256 px = _mm256_load_ps(X.v), py = _mm256_load_ps(Y.v), pz = _mm256_load_ps(Z.v);
+    // X, Y, Z as contacts with earlier candidates left them.
+    const __m256 cx = _mm256_load_ps(X.v), cy = _mm256_load_ps(Y.v), cz = _mm256_load_ps(Z.v);
     // The swept box (fixed per particle) against the ellipsoid's swept box, or the end position
     // as pass 0 saw it (lo = hi = x then) in the end box.
     const __m256 in_box = cont ? boxes8(lox, loy, loz, hix, hiy, hiz, qk.swept_min, qk.swept_max)
@@ -129,7 +203,7 @@ __attribute__((target("avx"))) bool EllipsoidCollider::collideEight(Eigen::Vecto
     if (!lanes) continue;
     st.tests += static_cast<uint32_t>(__builtin_popcount(static_cast<unsigned>(lanes)));
     __m256 q1x, q1y, q1z;
-    unitSpace8(qk.end_u, qk.end_c, px, py, pz, q1x, q1y, q1z);
+    unitSpace8(qk.end_u, qk.end_c, cx, cy, cz, q1x, q1y, q1z);
     const __m256 r2 = dot8(q1x, q1y, q1z, q1x, q1y, q1z);
     const __m256 inside = _mm256_cmp_ps(r2, one, _CMP_LT_OQ);
     __m256 q0x = zero, q0y = zero, q0z = zero, q0sq = zero, hit = inside;
@@ -161,7 +235,7 @@ __attribute__((target("avx"))) bool EllipsoidCollider::collideEight(Eigen::Vecto
       Vec3 x(X.v[j], Y.v[j], Z.v[j]);
       contact(shapes_[static_cast<size_t>(k)], Vec4(Q1X.v[j], Q1Y.v[j], Q1Z.v[j], 0.0f), R2.v[j],
               Vec4(Q0X.v[j], Q0Y.v[j], Q0Z.v[j], 0.0f), Q0SQ.v[j], (inside_bits >> j) & 1, cont, friction,
-              start[j], p, x, st);
+              Vec3(X0.v[j], Y0.v[j], Z0.v[j]), p, x, st);
       X.v[j] = x.x(), Y.v[j] = x.y(), Z.v[j] = x.z();
       moved |= 1 << j;
     }
@@ -171,16 +245,17 @@ __attribute__((target("avx"))) bool EllipsoidCollider::collideEight(Eigen::Vecto
     Vec3 x(X.v[j], Y.v[j], Z.v[j]);
     // The joint candidates narrowed to this lane's groups: where they cover x, settle tests the
     // same ellipsoids in the same order as after a gather of its own (collision.cpp, settle).
+    const size_t i = begin + static_cast<size_t>(j);
+    const uint64_t* allowed = allowedFor(grouped, i);
     Candidates mine = c;
     if (grouped) {
       if (mine.all) {
-        mine.allowed = allowed[j];
+        mine.allowed = allowed;
       } else {
-        for (int w = 0; w < words_; ++w) mine.mask[w] &= allowed[j][w];
+        for (int w = 0; w < words_; ++w) mine.mask[w] &= allowed[w];
       }
     }
-    settle(x, &mine, p, use_grid, allowed[j], st);
-    const size_t i = begin + static_cast<size_t>(j);
+    settle(x, &mine, p, use_grid, allowed, st);
     if (x != Vec3(positions[i].head<3>())) positions[i].head<3>() = x;
   }
   return true;
