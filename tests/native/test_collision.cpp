@@ -746,6 +746,9 @@ TEST(Collider, EightAtOnceMatchesOneAtATimeBitForBit) {
     for (size_t i = 0; i < s.x.size(); i += 37) s.prev[i].x() = nan;      // no start position
     for (size_t i = 5; i < s.x.size(); i += 41) s.x[i].y() = nan;         // skipped
     for (size_t i = 9; i < s.x.size(); i += 43) s.x[i].head<3>() += Vec3(5.0f, 0.0f, 0.0f);  // far
+    const float inf = std::numeric_limits<float>::infinity();
+    for (size_t i = 13; i < s.x.size(); i += 47) s.x[i].z() = inf;       // skipped (the lane test)
+    for (size_t i = 17; i < s.x.size(); i += 53) s.prev[i].z() = -inf;   // no start position
     std::vector<uint8_t> groups(static_cast<size_t>(n)), masks(s.x.size());
     for (size_t k = 0; k < groups.size(); ++k) groups[k] = static_cast<uint8_t>(1u << (k % 5));
     for (size_t i = 0; i < masks.size(); ++i) masks[i] = static_cast<uint8_t>((i / 6) % 3 == 0 ? 0x03 : 0x1C);
@@ -774,6 +777,42 @@ TEST(Collider, EightAtOnceMatchesOneAtATimeBitForBit) {
       }
     }
   }
+}
+
+// setEllipsoids reuses the previous call's end frame for a start ellipsoid equal to it (the
+// usual case between substeps): the collider must answer exactly as one given the same pair
+// fresh, and must not reuse anything when the ellipsoid or the margin differs.
+TEST(Collider, ReusedStartFrameAnswersAsAFreshCollider) {
+  const Scene s = randomScene(40, test::repeatsUnderSanitizers(3000, 4), 77);
+  std::vector<Ellipsoid> later = s.end;
+  for (Ellipsoid& e : later) e.centre += Vec3(0.01f, -0.02f, 0.005f);
+  CollisionParams p;
+  auto run = [&](const EllipsoidCollider& col) {
+    std::vector<Vec4> x = s.x;
+    const CollisionStats st = col.collide(x.data(), s.prev.data(), x.size(), p);
+    return std::make_pair(x, st.contacts);
+  };
+  for (float margin : {0.004f, 0.01f}) {
+    EllipsoidCollider carried, fresh;
+    carried.setEllipsoids(s.start.data(), s.end.data(), 40);  // default margin
+    carried.setEllipsoids(s.end.data(), later.data(), 40, margin);  // reuses only at the same margin
+    fresh.setEllipsoids(s.end.data(), later.data(), 40, margin);
+    const auto a = run(carried), b = run(fresh);
+    SCOPED_TRACE(::testing::Message() << "margin " << margin);
+    EXPECT_EQ(std::memcmp(a.first.data(), b.first.data(), a.first.size() * sizeof(Vec4)), 0);
+    EXPECT_EQ(a.second, b.second);
+    EXPECT_GT(a.second, 0u);
+  }
+  // A start that is not the previous end (every ellipsoid moved a little): built afresh.
+  EllipsoidCollider carried, fresh;
+  std::vector<Ellipsoid> other = s.end;
+  for (Ellipsoid& e : other) e.radii *= 1.05f;
+  carried.setEllipsoids(s.start.data(), s.end.data(), 40);
+  carried.setEllipsoids(other.data(), later.data(), 40);
+  fresh.setEllipsoids(other.data(), later.data(), 40);
+  const auto a = run(carried), b = run(fresh);
+  EXPECT_EQ(std::memcmp(a.first.data(), b.first.data(), a.first.size() * sizeof(Vec4)), 0);
+  EXPECT_EQ(a.second, b.second);
 }
 
 TEST(Collider, ParticlesAreIndependent) {
