@@ -29,6 +29,24 @@ Section sectionAt(const std::vector<RingPose>& rings, int r0, float t) {
 // Bindings beyond this many blend widths from the nearest get weight < 1.8 % and are dropped.
 constexpr float kBlendCutoff = 0.018f;
 
+// A lower bound of bindToSegment(rings, c, r0, p).dist: the point's distance to the segment
+// between the two ring centres less the largest semi-axis of the two rings. (bindToSegment's
+// section centre lies on that segment and its frame is orthonormal, so |q| is at least that
+// distance; its dist is at least |q| less the ellipse's radius in q's direction, and the section's
+// semi-axes interpolate the rings'.)
+float segmentLowerBound(const std::vector<RingPose>& rings, int r0, const Vec3& p) {
+  const RingPose& A = rings[static_cast<size_t>(r0)];
+  const RingPose& B = rings[static_cast<size_t>(r0) + 1];
+  const Vec3 d = B.centre - A.centre;
+  const float dd = d.squaredNorm();
+  const float t = dd > 1e-12f ? std::clamp((p - A.centre).dot(d) / dd, 0.0f, 1.0f) : 0.0f;
+  const float reach = std::max(std::max(A.forward_m, A.side_m), std::max(B.forward_m, B.side_m));
+  return (p - (A.centre + t * d)).norm() - reach;
+}
+// Float rounding in the bound and in dist is ~1e-6 m at body scale; this keeps every pruned
+// segment well clear of the cut-off.
+constexpr float kBoundSlackM = 1e-3f;
+
 }  // namespace
 
 RingBinding bindToSegment(const std::vector<RingPose>& rings, int chain, int r0, const Vec3& p) {
@@ -66,11 +84,35 @@ void RingSkin::bind(const BodyModel& layout, const std::vector<RingPose>& rings,
   weight_.clear();
   offset_.assign(1, 0);
   std::vector<RingBinding> cands;
+  // Every segment of every chain, in chain order (the order the blend is summed in).
+  std::vector<std::pair<int, int>> segments;
+  for (int c = 0; c < kChainCount; ++c) {
+    const int first = layout.chainFirstRing(Chain(c)), n = layout.chainRingCount(Chain(c));
+    for (int i = 0; i + 1 < n; ++i) segments.emplace_back(c, first + i);
+  }
+  std::vector<float> bound(segments.size());
+  // A segment whose binding would get a blend weight below the cut-off even against the nearest
+  // one plays no part: neither nearest nor blended. Its lower bound says so without the binding
+  // (most of the body's segments, for any point), with the nearest bounded from above by the
+  // segment of the smallest lower bound. The kept bindings, their order and weights are those
+  // of binding every segment (test_ring_skin.cpp).
+  const float keep_within = blend_m > 0.0f ? blend_m * -std::log(kBlendCutoff) + kBoundSlackM : kBoundSlackM;
   for (size_t v = 0; v < points.size(); ++v) {
     cands.clear();
-    for (int c = 0; c < kChainCount; ++c) {
-      const int first = layout.chainFirstRing(Chain(c)), n = layout.chainRingCount(Chain(c));
-      for (int i = 0; i + 1 < n; ++i) cands.push_back(bindToSegment(rings, c, first + i, points[v]));
+    size_t likely = 0;
+    for (size_t k = 0; k < segments.size(); ++k) {
+      bound[k] = segmentLowerBound(rings, segments[k].second, points[v]);
+      if (bound[k] < bound[likely]) likely = k;
+    }
+    const float nearest_at_most =
+        segments.empty() ? 0.0f : bindToSegment(rings, segments[likely].first, segments[likely].second, points[v]).dist;
+    for (size_t k = 0; k < segments.size(); ++k) {
+      if (bound[k] > nearest_at_most + keep_within) continue;
+      cands.push_back(bindToSegment(rings, segments[k].first, segments[k].second, points[v]));
+    }
+    if (cands.empty()) {  // no segments at all (a body always has some): nothing bound
+      offset_.push_back(static_cast<uint32_t>(blend_.size()));
+      continue;
     }
     primary_[v] = *std::min_element(cands.begin(), cands.end(),
                                     [](const RingBinding& a, const RingBinding& b) { return a.dist < b.dist; });
