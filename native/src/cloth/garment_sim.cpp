@@ -21,6 +21,11 @@ double msSince(Clock::time_point t0) {
 
 // Frames of settling and of dressing run at this rate (the recording rate of a Kinect).
 constexpr float kSettleFrameS = 1.0f / 30.0f;
+// A host step shorter than this simulates this much cloth time: the solvers' velocities are
+// (x - x_prev) / h, and a substep of a few nanoseconds turns float rounding of the positions into
+// metres per second (a denormal h overflowed 1/h to infinity and 0 * inf poisoned the state;
+// found by fuzz_capi with dt = 6.3e-41 s). 10 us of cloth time is invisible.
+constexpr float kMinStepS = 1e-5f;
 // Dressing starts with the body at this fraction of its size (see GarmentSim::create).
 constexpr float kDressStartScale = 0.6f;
 // Soft choice of skinning segment (as the OBJ fit's default): see cloth/ring_skin.h.
@@ -374,7 +379,7 @@ void GarmentSim::runFrame(const std::vector<Ellipsoid>& start, const std::vector
   std::string err;
   solver_->setPins(pins, err);
   solver_->setMotion(&collider_, start, end, params_.collision_margin_m, err);
-  const float sim = std::min(dt, params_.max_step_s);
+  const float sim = std::clamp(dt, kMinStepS, params_.max_step_s);
   const int n = std::clamp(static_cast<int>(std::ceil(sim * params_.substep_hz - 1e-3f)), 1, params_.max_substeps);
   if (staging_ && solver_->stageStep(sim, n)) {
     staged_ = true;  // the caller runs it (with other garments' frames) before stepEnd()
@@ -523,10 +528,12 @@ void GarmentSim::stepEnd() {
   const BodyModel& body = *pending_body_;
   const std::vector<Ellipsoid>& end = *pending_end_;
   const RingPose& pr = body.rings()[static_cast<size_t>(pelvis_ring_)];
-  // NaN guard (cannot happen with validated input; if it does, never hand NaN to the host).
+  // NaN guard (cannot happen with validated input; if it does, never hand NaN to the host). The
+  // velocities too: a non-finite velocity is the next step's non-finite position.
   const Eigen::Vector4f* x = solver_->x();
+  const Eigen::Vector4f* v = solver_->v();
   for (size_t i = 0; i < particleCount(); ++i) {
-    if (!x[i].allFinite()) {
+    if (!x[i].allFinite() || !v[i].allFinite()) {
       placeOnBody(body, end);
       last_.nan_reset = true;
       break;

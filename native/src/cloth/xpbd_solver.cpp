@@ -346,8 +346,10 @@ bool XpbdSolver::reset(const Vec3* positions, size_t count, std::string& error) 
       return false;
     }
   }
+  // w from the topology as well: a reset is also how a garment recovers from a bad state, and
+  // the inverse masses are part of what must be right afterwards.
   for (size_t i = 0; i < count; ++i) {
-    x_[i].head<3>() = positions[i];
+    x_[i] = Vec4(positions[i].x(), positions[i].y(), positions[i].z(), topology_.inverse_mass[i]);
     v_[i].setZero();
   }
   prev_ = x_;  // same size: no allocation
@@ -357,6 +359,7 @@ bool XpbdSolver::reset(const Vec3* positions, size_t count, std::string& error) 
 
 bool XpbdSolver::step(float dt, int substeps) {
   if (!(dt > 0.0f) || !(dt <= 1.0f) || substeps < 1 || substeps > 1000) return false;
+  if (!(dt / static_cast<float>(substeps) >= kMinSubstepS)) return false;
   for (size_t k = 0; k < pin_start_.size(); ++k)
     pin_start_[k] = x_[topology_.pinned[k]].head<3>();
   collision_stats_ = CollisionStats{};

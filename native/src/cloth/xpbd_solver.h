@@ -85,12 +85,15 @@ class XpbdSolver {
   // and to reset it on a teleport. R must be a rotation; nothing is checked (internal use).
   void transform(const Mat3& R, const Vec3& pivot, const Vec3& t, float velocity_scale);
 
-  // Teleport: all particles to `positions` (particleCount() xyz), velocities zero, pin targets =
-  // the new pinned positions. Rejects a count mismatch or non-finite input.
+  // Teleport: all particles to `positions` (particleCount() xyz), velocities zero, inverse masses
+  // from the topology, pin targets = the new pinned positions. Rejects a count mismatch or
+  // non-finite input.
   bool reset(const Vec3* positions, size_t count, std::string& error);
 
-  // Advances dt seconds in `substeps` substeps. Rejects dt not in (0, 1] or substeps not in
-  // [1, 1000].
+  // Advances dt seconds in `substeps` substeps. Rejects dt not in (0, 1], substeps not in
+  // [1, 1000], or a substep shorter than kMinSubstepS (velocities are (x - x_prev) / h: a tiny h
+  // makes float rounding a speed, a denormal one overflows): false, nothing changed.
+  static constexpr float kMinSubstepS = 1e-6f;
   bool step(float dt, int substeps = kDefaultSubsteps);
 
   const GarmentTopology& topology() const { return topology_; }

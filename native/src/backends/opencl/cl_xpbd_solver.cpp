@@ -316,8 +316,8 @@ bool ClXpbdSolver::reset(const Vec3* positions, size_t count, std::string& error
       return false;
     }
   }
-  for (size_t i = 0; i < count; ++i) {
-    x_[i].head<3>() = positions[i];
+  for (size_t i = 0; i < count; ++i) {  // w from the topology too (as XpbdSolver::reset)
+    x_[i] = Eigen::Vector4f(positions[i].x(), positions[i].y(), positions[i].z(), topology_.inverse_mass[i]);
     v_[i].setZero();
   }
   for (size_t k = 0; k < pin_target_.size(); ++k) pin_target_[k] = positions[pin_index_[k]];
