@@ -308,7 +308,8 @@ namespace Drape
         /// <summary>
         /// Advances the world by <paramref name="dt"/> seconds, the host's frame time, in (0, 10]
         /// (drape_context_step): runs <see cref="Update"/> if a frame is queued, then every garment
-        /// follows the body from where it was at the last step, in ceil(dt * SubstepHz) substeps.
+        /// follows the body from where it was at the last step, in ceil(dt * SubstepHz) substeps
+        /// (the cloth simulates dt clamped to [1e-5 s, MaxStepS]).
         /// Throws <see cref="ResultCode.CallOrder"/> before the first accepted frame. Invalidates
         /// every <see cref="Garment.ViewPositions"/> span. No managed allocation.
         /// </summary>

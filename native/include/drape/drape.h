@@ -524,6 +524,7 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_get_params(drape_garment* garmen
 /* Advances the world by dt seconds (the host's frame time; it may vary from frame to frame): runs
  * drape_context_update if a frame is queued, then every garment follows the body from where it
  * was at the last step to where it is now, in ceil(dt * substep_hz) substeps. dt in (0, 10];
+ * the cloth simulates dt clamped to [1e-5, max_step_s] (a shorter step is no time to simulate).
  * DRAPE_ERROR_CALL_ORDER before the first accepted frame. Thread-safety: one thread per context. */
 DRAPE_API drape_result DRAPE_CALL drape_context_step(drape_context* context, float dt);
 
