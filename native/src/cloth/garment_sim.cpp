@@ -529,11 +529,12 @@ void GarmentSim::stepEnd() {
   const std::vector<Ellipsoid>& end = *pending_end_;
   const RingPose& pr = body.rings()[static_cast<size_t>(pelvis_ring_)];
   // NaN guard (cannot happen with validated input; if it does, never hand NaN to the host). The
-  // velocities too: a non-finite velocity is the next step's non-finite position.
+  // positions only: a device solver keeps its velocities on the device (reading them would cost
+  // a transfer every frame), and a non-finite velocity shows in the next step's positions, where
+  // placeOnBody's reset repairs everything, inverse masses and velocities included.
   const Eigen::Vector4f* x = solver_->x();
-  const Eigen::Vector4f* v = solver_->v();
   for (size_t i = 0; i < particleCount(); ++i) {
-    if (!x[i].allFinite() || !v[i].allFinite()) {
+    if (!x[i].allFinite()) {
       placeOnBody(body, end);
       last_.nan_reset = true;
       break;

@@ -14,11 +14,6 @@
 #include <immintrin.h>
 #define DRAPE_XPBD_AVX 1  // an 8-lane AVX kernel, chosen at run time (no FMA: same results)
 #endif
-#if defined(__GNUC__) || defined(__clang__)
-#define DRAPE_XPBD_INLINE __attribute__((always_inline))
-#else
-#define DRAPE_XPBD_INLINE
-#endif
 
 namespace drape {
 namespace {
@@ -250,6 +245,13 @@ void XpbdSolver::buildBatches() {
   }
   appendPadded(topology_.tether, 0.0f, dummy, nullptr, 0, tethers_.a, tethers_.b,
                tethers_.rest, tethers_.compliance, tethers_.group_offsets);
+  // The inverse masses are the topology's and never change (reset restores them), so their pair
+  // sums are fixed with the batches; the dummy particle weighs nothing (w = 0).
+  auto w = [&](uint32_t i) { return i < dummy ? topology_.inverse_mass[i] : 0.0f; };
+  for (Batches* b : {&distance_, &tethers_}) {
+    b->w_ab.resize(b->a.size());
+    for (size_t k = 0; k < b->a.size(); ++k) b->w_ab[k] = w(b->a[k]) + (b == &tethers_ ? 0.0f : w(b->b[k]));
+  }
   refreshCompliance();
 }
 
@@ -257,13 +259,6 @@ void XpbdSolver::refreshCompliance() {
   inv_w_h2_ = -1.0f;  // recompute inv_w at the next substep
   distance_.inv_w.resize(distance_.a.size());
   tethers_.inv_w.resize(tethers_.a.size());
-  // Inverse masses never change after construction (reset, transform and mutablePositions keep
-  // w), so their pair sums are computed once here.
-  for (Batches* b : {&distance_, &tethers_}) {
-    b->w_ab.resize(b->a.size());
-    for (size_t k = 0; k < b->a.size(); ++k)
-      b->w_ab[k] = x_[b->a[k]].w() + (b == &tethers_ ? 0.0f : x_[b->b[k]].w());
-  }
   const float by_kind[4] = {params_.stretch_compliance, params_.shear_compliance,
                             params_.bend_compliance, 0.0f};
   for (size_t k = 0; k < distance_kind_.size(); ++k)
@@ -417,7 +412,7 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
   const float h_drag = h * p.drag;
   const float max_speed2 = p.max_speed > 0.0f ? p.max_speed * p.max_speed : 0.0f;
   // Particle i's prediction from its velocity v (xi = its position now).
-  auto predict = [&](size_t i, const Vec4& xi, Vec4 v) DRAPE_XPBD_INLINE {
+  auto predict = [&](size_t i, const Vec4& xi, Vec4 v) DRAPE_LAMBDA_INLINE {
     prev[i] = xi;
     if (xi.w() == 0.0f) {
       vel[i] = v;

@@ -561,9 +561,7 @@ CollisionStats EllipsoidCollider::collide(Eigen::Vector4f* positions,
       if (!has_prev) x0 = x;
     }
     Vec3 y = x;
-    const uint64_t* allowed =
-        grouped ? &allowed_[static_cast<size_t>(particle_masks_[i]) * (kMaxGridEllipsoids / 64)] : nullptr;
-    resolveParticle(y, x0, has_prev, p, allowed, st);
+    resolveParticle(y, x0, has_prev, p, allowedFor(grouped, i), st);
     if (y != x) positions[i].head<3>() = y;
   }
   return st;

@@ -158,9 +158,13 @@ class EllipsoidCollider {
   // first: pass 0's candidates for this particle, or null (then gathered where needed).
   void settle(Vec3& x, const Candidates* first, const CollisionParams& p, bool use_grid,
               const uint64_t* allowed, CollisionStats& stats) const;
-  // Particle i's collision-group row of allowed_ (grouped), or null.
+  // The ellipsoids a particle with collision mask `mask` may touch (allowed_'s row), and particle
+  // i's row when collide() uses groups (null otherwise).
+  const uint64_t* allowedRow(uint8_t mask) const {
+    return &allowed_[static_cast<size_t>(mask) * (kMaxGridEllipsoids / 64)];
+  }
   const uint64_t* allowedFor(bool grouped, size_t i) const {
-    return grouped ? &allowed_[static_cast<size_t>(particle_masks_[i]) * (kMaxGridEllipsoids / 64)] : nullptr;
+    return grouped ? allowedRow(particle_masks_[i]) : nullptr;
   }
   // Whether particle i of collide() can touch anything (collision_internal.h).
   bool mayTouch(const Eigen::Vector4f* positions, const Eigen::Vector4f* previous, size_t i, bool swept) const;

@@ -124,13 +124,15 @@ __attribute__((target("avx"))) bool EllipsoidCollider::collideEight(Eigen::Vecto
   const __m256 zero = _mm256_setzero_ps();
   const __m256 finite = finite8(px, py, pz);
   const __m256 finite0 = previous ? finite8(p0x, p0y, p0z) : finite;
+  // Each lane's box: its motion box with the swept test (finite start positions: plain min /
+  // max), else its end position.
+  const __m256 lox = cont ? _mm256_min_ps(px, p0x) : px, loy = cont ? _mm256_min_ps(py, p0y) : py,
+               loz = cont ? _mm256_min_ps(pz, p0z) : pz;
+  const __m256 hix = cont ? _mm256_max_ps(px, p0x) : px, hiy = cont ? _mm256_max_ps(py, p0y) : py,
+               hiz = cont ? _mm256_max_ps(pz, p0z) : pz;
   const Vec4 gmin = lift(grid_min_), gmax = lift(grid_max_);
   __m256 touch = boxes8(px, py, pz, px, py, pz, gmin, gmax);  // x inside the grid's box
-  if (cont) {  // or its swept box overlaps it (finite start positions: plain min / max)
-    touch = _mm256_or_ps(touch, boxes8(_mm256_min_ps(px, p0x), _mm256_min_ps(py, p0y), _mm256_min_ps(pz, p0z),
-                                       _mm256_max_ps(px, p0x), _mm256_max_ps(py, p0y), _mm256_max_ps(pz, p0z),
-                                       gmin, gmax));
-  }
+  if (cont) touch = _mm256_or_ps(touch, boxes8(lox, loy, loz, hix, hiy, hiz, gmin, gmax));  // or its motion box
   touch = _mm256_and_ps(_mm256_and_ps(touch, finite), _mm256_cmp_ps(pw, zero, _CMP_GT_OQ));
   // A lane without a finite start position goes the one-particle way (its own mayTouch first:
   // the swept box test above assumed finite start positions).
@@ -147,10 +149,6 @@ __attribute__((target("avx"))) bool EllipsoidCollider::collideEight(Eigen::Vecto
     if (y != x) positions[i].head<3>() = y;
   }
   if (active == 0) return true;
-  const __m256 lox = cont ? _mm256_min_ps(px, p0x) : px, loy = cont ? _mm256_min_ps(py, p0y) : py,
-               loz = cont ? _mm256_min_ps(pz, p0z) : pz;
-  const __m256 hix = cont ? _mm256_max_ps(px, p0x) : px, hiy = cont ? _mm256_max_ps(py, p0y) : py,
-               hiz = cont ? _mm256_max_ps(pz, p0z) : pz;
   _mm256_store_ps(X.v, px), _mm256_store_ps(Y.v, py), _mm256_store_ps(Z.v, pz);
   _mm256_store_ps(X0.v, p0x), _mm256_store_ps(Y0.v, p0y), _mm256_store_ps(Z0.v, p0z);
   // The joint box of the lanes taking part (the others set to an empty box first).
@@ -173,7 +171,7 @@ __attribute__((target("avx"))) bool EllipsoidCollider::collideEight(Eigen::Vecto
     m |= m >> 32;
     m |= m >> 16;
     m |= m >> 8;
-    joint_allowed = &allowed_[static_cast<size_t>(m & 0xFFu) * (kMaxGridEllipsoids / 64)];
+    joint_allowed = allowedRow(static_cast<uint8_t>(m & 0xFFu));
   }
   Candidates c;
   if (!gather(lo, hi, use_grid, joint_allowed, c)) return true;

@@ -3,6 +3,7 @@
 // here so that both translation units inline it.
 #pragma once
 
+#include "common/cpu.h"
 #include "proxies/collision.h"
 
 #include <cstdint>
@@ -14,13 +15,6 @@
 #include <emmintrin.h>
 #endif
 
-#if defined(__GNUC__)
-#define DRAPE_ALWAYS_INLINE __attribute__((always_inline)) inline
-#define DRAPE_LAMBDA_INLINE __attribute__((always_inline))
-#else
-#define DRAPE_ALWAYS_INLINE inline
-#define DRAPE_LAMBDA_INLINE
-#endif
 
 namespace drape {
 namespace collision_internal {
