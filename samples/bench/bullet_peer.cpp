@@ -80,9 +80,14 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
   out.take = take.name;
   out.rate_hz = take.rate_hz;
 
-  // The driver: Drape at its default setting.
+  // The driver: Drape at its default setting, but for the garment's cut: Bullet gets the mesh and
+  // rest shape Drape starts with, so Drape keeps that cut too (DRAPE_GARMENT_FIT_SHAPE: no refit
+  // to the person's skeleton at calibration) and both simulate the same garment.
+  drape_context_desc desc;
+  drape_context_desc_init(&desc);
+  desc.garment_fit = DRAPE_GARMENT_FIT_SHAPE;
   drape_context* raw = nullptr;
-  if (drape_result r = drape_context_create(nullptr, &raw)) return failed("drape_context_create", r, error);
+  if (drape_result r = drape_context_create(&desc, &raw)) return failed("drape_context_create", r, error);
   std::unique_ptr<drape_context, ContextDeleter> ctx(raw);
   drape_garment_template tmpl;
   drape_garment_template_init(&tmpl);

@@ -73,6 +73,16 @@ void StretchMeter::setMesh(const std::vector<uint32_t>& indices, const std::vect
   }
 }
 
+void StretchMeter::setRest(const std::vector<drape_vec3>& rest) {
+  for (size_t k = 0; k < a_.size(); ++k) {
+    const drape_vec3& p = rest[a_[k]];
+    const drape_vec3& q = rest[b_[k]];
+    const double dx = p.x - q.x, dy = p.y - q.y, dz = p.z - q.z;
+    const double len = std::sqrt(dx * dx + dy * dy + dz * dz);
+    if (len > 0.0) rest_[k] = len;
+  }
+}
+
 void StretchMeter::addFrame(const drape_vec3* x) {
   for (size_t k = 0; k < a_.size(); ++k) {
     const drape_vec3& p = x[a_[k]];

@@ -43,6 +43,9 @@ class PenetrationMeter {
 class StretchMeter {
  public:
   void setMesh(const std::vector<uint32_t>& indices, const std::vector<drape_vec3>& rest);
+  // New rest lengths for the same edges (the garment was cut again: drape_garment_stats.refits);
+  // the samples so far stay.
+  void setRest(const std::vector<drape_vec3>& rest);
   void addFrame(const drape_vec3* vertices);
   double p99() const { return percentile(samples_, 99.0); }
   double max() const { return maximum(samples_); }

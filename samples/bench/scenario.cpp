@@ -207,6 +207,7 @@ bool runDrape(const Take& take, const Setting& s, const RunOptions& o, RunResult
   stretch.setMesh(out.indices, out.rest);
   std::vector<drape_vec3> x(nv);
   std::vector<double> inside, substeps;
+  uint32_t refits = 0;
   for (size_t i = 0; i < take.frames.size(); ++i) {
     drape_skeleton_frame f{};
     f.struct_size = sizeof f;
@@ -234,6 +235,14 @@ bool runDrape(const Take& take, const Setting& s, const RunOptions& o, RunResult
       return false;
     out.attached = gs.attached;
     out.nan_resets += gs.nan_reset;
+    if (gs.refits != refits) {
+      // Cut again for the person's skeleton (drape_garment_fit): stretch against the new rest shape.
+      refits = gs.refits;
+      if (!ok("drape_garment_read_rest_positions", drape_garment_read_rest_positions(garment, out.rest.data(), nv),
+              error))
+        return false;
+      stretch.setRest(out.rest);
+    }
     substeps.push_back(gs.substeps);
     // The first frame (pose blended in over extra frames) and teleports are not steady frames.
     if (gs.blend_frames == 0 && !gs.teleport_reset)

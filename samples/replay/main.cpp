@@ -141,6 +141,7 @@ int run(int argc, char** argv) {
   drape_context_desc_init(&desc);
   if (opt.ring_points != 0) desc.ring_points = opt.ring_points;
   desc.proxy_rule = opt.proxy_rule;
+  desc.garment_fit = opt.garment_fit;
   drape_context* raw_ctx = nullptr;
   if (drape_result r = drape_context_create(&desc, &raw_ctx)) {
     if (isFatalLibraryError(r)) return fail(kExitFailure, "drape_context_create failed: " + libraryReason(r));
@@ -214,6 +215,7 @@ int run(int argc, char** argv) {
   st.recording_rate_hz = info.nominal_rate_hz;
   st.ring_points = desc.ring_points;
   st.proxy_rule = desc.proxy_rule;
+  st.garment_fit = desc.garment_fit;
   if (opt.backend == "opencl") {
     // OpenCL for the cloth; without a working device the library falls back to the CPU and says
     // why: the replay goes on and the stats record it (backend "cpu", backend_fallback).
@@ -443,6 +445,15 @@ int run(int argc, char** argv) {
     st.contacts.push_back(gs.contacts);
     st.substeps.push_back(gs.substeps);
     st.teleport_resets += gs.teleport_reset ? 1u : 0u;
+    if (gs.refits != st.refits) {
+      // Cut again (the skeleton's calibration): stretch from now on is against the new rest shape.
+      std::vector<drape_vec3> rest(garment_vertices);
+      if (drape_result r = drape_garment_read_rest_positions(garment, rest.data(), garment_vertices))
+        return fail(kExitFailure, "drape_garment_read_rest_positions failed: " + libraryReason(r));
+      st.nonfinite += replay::countNonFinite(rest);
+      st.stretch.setRest(rest);
+      st.refits = gs.refits;
+    }
     st.nan_resets += gs.nan_reset ? 1u : 0u;
 
     if (opt.measure_every != 0 && (st.cloth_ms.size() - 1) % opt.measure_every == 0) {

@@ -202,6 +202,16 @@ bool parseOptions(int argc, const char* const* argv, Options& o, std::string& er
         error = "--proxy-rule '" + value + "' is not 'paper' or 'drape'";
         return false;
       }
+    } else if (name == "--garment-fit") {
+      if (!takeValue()) return false;
+      if (value == "skeleton") {
+        o.garment_fit = DRAPE_GARMENT_FIT_SKELETON;
+      } else if (value == "shape") {
+        o.garment_fit = DRAPE_GARMENT_FIT_SHAPE;
+      } else {
+        error = "--garment-fit '" + value + "' is not 'skeleton' or 'shape'";
+        return false;
+      }
     } else if (name == "--fidelity-every") {
       if (!takeValue()) return false;
       if (!parseUint(value, 0, 0xffffffffUL, o.fidelity_every)) {
@@ -398,6 +408,9 @@ std::string helpText() {
       "  --garment G           tshirt (default), longsleeve, skirt, dress, trousers, none (no cloth:\n"
       "                        push + update only), or PATH.obj (a garment mesh, e.g. from MakeHuman)\n"
       "  --particles N         template garment resolution, in [200, 200000] (default 2000)\n"
+      "  --garment-fit F       skeleton (default: once the bone lengths are calibrated, the garment\n"
+      "                        is cut again for this person's bones and torso) or shape (the body\n"
+      "                        shape's standard proportions only)\n"
       "  --solver S            xpbd (default) or massspring (the paper's mass-spring; it needs\n"
       "                        ~3 kHz, so it runs at 2880 Hz unless --substeps is given)\n"
       "  --substeps N          cloth substeps per 1/30 s frame, in [1, 666]: substep_hz = 30 * N\n"

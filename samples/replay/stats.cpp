@@ -188,6 +188,8 @@ std::string statsJson(const ReplayStats& s) {
   w.key("triangles").value(s.garment_triangles);
   w.key("edges").value(static_cast<int64_t>(s.stretch.edgeCount()));
   w.key("attached").value(s.attached);
+  w.key("fit").value(s.garment_fit == DRAPE_GARMENT_FIT_SHAPE ? "shape" : "skeleton");
+  w.key("refits").value(s.refits);
   w.key("frames_stepped").value(static_cast<uint32_t>(s.cloth_ms.size()));
   w.key("max_stretch").value(s.stretch.max());
   w.key("p99_stretch").value(s.stretch.percentile(99.0));
@@ -259,6 +261,12 @@ std::string summaryText(const ReplayStats& s, const std::string& obj_dir, const 
         s.garment_kind.c_str(), s.garment_from_obj ? "OBJ" : "template",
         s.solver == DRAPE_SOLVER_MASS_SPRING ? "massspring" : "xpbd", s.substep_hz, passes.c_str(), s.particles,
         s.attached, s.garment_triangles);
+    appendf(o, "fit         %s%s\n",
+            s.garment_fit == DRAPE_GARMENT_FIT_SHAPE ? "the body shape's standard proportions (--garment-fit shape)"
+                                                     : "the person's skeleton once calibrated",
+            s.garment_fit == DRAPE_GARMENT_FIT_SHAPE ? ""
+            : s.refits > 0 ? (", cut again " + std::to_string(s.refits) + "x").c_str()
+                           : ", no refit (proportions within 1 cm of the standard ones, or not calibrated)");
     appendf(o, "backend     %s%s%s%s\n", s.backend.c_str(), s.device.empty() ? "" : (" on " + s.device).c_str(),
         s.backend_fallback.empty() ? "" : " (OpenCL not used: ", s.backend_fallback.empty() ? "" : (s.backend_fallback + ")").c_str());
     appendf(o, "stretch     max %.2f %%, P99 %.2f %% (%zu edges x %zu frames pooled)\n", 100.0 * s.stretch.max(),

@@ -43,6 +43,18 @@ void StretchAccumulator::setMesh(const std::vector<uint32_t>& indices, const std
   max_ = -std::numeric_limits<double>::infinity();
 }
 
+void StretchAccumulator::setRest(const std::vector<drape_vec3>& rest) {
+  for (size_t k = 0; k < a_.size(); ++k) {
+    if (a_[k] >= rest.size() || b_[k] >= rest.size()) continue;
+    const drape_vec3& u = rest[a_[k]];
+    const drape_vec3& v = rest[b_[k]];
+    const double dx = static_cast<double>(u.x) - v.x, dy = static_cast<double>(u.y) - v.y,
+                 dz = static_cast<double>(u.z) - v.z;
+    const double len = std::sqrt(dx * dx + dy * dy + dz * dz);
+    if (len > 0.0 && std::isfinite(len)) rest_[k] = static_cast<float>(len);
+  }
+}
+
 void StretchAccumulator::addFrame(const std::vector<drape_vec3>& p) {
   for (size_t k = 0; k < a_.size(); ++k) {
     const drape_vec3& u = p[a_[k]];

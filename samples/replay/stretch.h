@@ -21,6 +21,10 @@ class StretchAccumulator {
   // `rest` (drape_garment_read_rest_positions). Edges of rest length 0 are left out.
   void setMesh(const std::vector<uint32_t>& indices, const std::vector<drape_vec3>& rest);
 
+  // New rest lengths for the same edges (the garment was refitted: drape_garment_stats.refits);
+  // the samples so far stay. Edges whose new rest length is 0 keep the old one.
+  void setRest(const std::vector<drape_vec3>& rest);
+
   // Adds one frame's stretch samples. Edges with a non-finite length are skipped (the caller
   // counts non-finite positions).
   void addFrame(const std::vector<drape_vec3>& positions);

@@ -124,7 +124,7 @@ struct Machine {
       d.jitter_radius_m = in.inRange(0.0f, 1.0f);
     }
     if (mode & 4) d.struct_size = in.u8();  // usually too small
-    if (mode & 8) d.reserved = in.u8();
+    if (mode & 8) d.garment_fit = static_cast<int32_t>(in.u8() % 3);  // 2 is out of range
     drape_context* h = nullptr;
     if (DRAPE_FUZZ_CALL(drape_context_create((mode & 16) && (mode & 32) ? nullptr : &d, &h)) == DRAPE_OK) {
       DRAPE_FUZZ_CHECK(h != nullptr, "create OK gives a handle");

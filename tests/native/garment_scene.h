@@ -57,10 +57,8 @@ inline GarmentSim* addTemplate(Context& ctx, GarmentKind kind, int particles, Cl
   GarmentTemplateParams tp;
   tp.kind = kind;
   tp.target_particles = particles;
-  GarmentMesh mesh;
-  if (!makeGarmentTemplate(ctx.restBody(), tp, mesh, err)) return nullptr;
-  auto g = GarmentSim::create(mesh, TopologyParams{}, solver, params, dress_time_s, ctx.restBody(),
-                              ctx.restEllipsoids(), ctx.restEllipsoidChains(), err);
+  auto g = GarmentSim::createTemplate(tp, TopologyParams{}, solver, params, dress_time_s, ctx.restBody(),
+                                     ctx.restEllipsoids(), ctx.restEllipsoidChains(), err);
   return g ? ctx.adoptGarment(std::move(g)) : nullptr;
 }
 

@@ -567,7 +567,7 @@ TEST(Capi, DescInitFillsDocumentedDefaults) {
   EXPECT_EQ(d.calibration_frames, 30u);
   EXPECT_EQ(d.filter, DRAPE_FILTER_ONE_EURO);
   EXPECT_EQ(d.proxy_rule, DRAPE_PROXY_RULE_DRAPE);
-  EXPECT_EQ(d.reserved, 0u);
+  EXPECT_EQ(d.garment_fit, DRAPE_GARMENT_FIT_SKELETON);
   EXPECT_FLOAT_EQ(d.teleport_distance_m, 0.5f);
   EXPECT_GT(d.filter_min_cutoff_hz, 0.0f);
   EXPECT_GE(d.filter_beta, 0.0f);
@@ -2158,20 +2158,19 @@ TEST(Capi, EllipsoidsCallOrderBuffersAndGeometry) {
   }
 }
 
-// drape.h documents `reserved` fields as 0 (drape_context_desc.reserved,
-// drape_skeleton_frame.reserved). A field that must be 0 is only reservable for later use if
-// non-zero values are rejected now; otherwise hosts that leave garbage there break silently when
-// it gains a meaning.
-// KNOWN GAP (native/src/capi/context.cpp: validateContextDesc and Context::pushFrame): neither
-// checks `reserved`; a desc or frame with reserved = 0xdeadbeef is accepted. Suggested fix: reject
-// with DRAPE_ERROR_INVALID_ARGUMENT ("reserved must be 0"), counting the frame as rejected.
+// drape.h documents `reserved` fields as 0 (drape_skeleton_frame.reserved). A field that must be
+// 0 is only reservable for later use if non-zero values are rejected now; otherwise hosts that
+// leave garbage there break silently when it gains a meaning. (drape_context_desc's reserved field
+// became garment_fit that way: 0 is its default, anything but 0 and 1 is refused.)
 TEST(Capi, ReservedFieldsMustBeZero) {
   drape_context_desc d;
   ASSERT_OK(drape_context_desc_init(&d));
-  d.reserved = 0xdeadbeefu;
-  drape_context* out = kContextSentinel;
-  EXPECT_FAILS(DRAPE_ERROR_INVALID_ARGUMENT, "drape_context_create", drape_context_create(&d, &out));
-  if (out != kContextSentinel) drape_context_destroy(out);
+  for (int32_t fit : {2, -1, 0x7fffffff}) {
+    d.garment_fit = fit;
+    drape_context* out = kContextSentinel;
+    EXPECT_FAILS(DRAPE_ERROR_OUT_OF_RANGE, "drape_context_create", drape_context_create(&d, &out));
+    if (out != kContextSentinel) drape_context_destroy(out);
+  }
 
   ContextPtr ctx = makeContext();
   const std::vector<drape_joint> j = poseJoints(DRAPE_LAYOUT_KINECT2, 0.0);

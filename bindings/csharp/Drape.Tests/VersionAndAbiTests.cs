@@ -142,7 +142,7 @@ namespace Drape.Tests
             ("StructSize", 0), ("RingPoints", 4), ("RingsPerSegment", 8), ("CalibrationFrames", 12), ("Filter", 16),
             ("FilterMinCutoffHz", 20), ("FilterBeta", 24), ("FilterDCutoffHz", 28), ("Smoothing", 32), ("Correction", 36),
             ("Prediction", 40), ("JitterRadiusM", 44), ("MaxDeviationM", 48), ("TeleportDistanceM", 52),
-            ("ProxyRule", 56), ("Reserved", 60));
+            ("ProxyRule", 56), ("GarmentFit", 60));
 
         [Fact]
         public void BodyShape_Is48() => AssertLayout<BodyShape>(48,
@@ -205,7 +205,7 @@ namespace Drape.Tests
         public void GarmentStats_Is72() => AssertLayout<GarmentStats>(72,
             ("StructSize", 0), ("Particles", 4), ("Attached", 8), ("Substeps", 12), ("BlendFrames", 16), ("Contacts", 20),
             ("SweptCatches", 24), ("Escapes", 28), ("Steps", 32), ("TeleportReset", 40), ("NanReset", 41),
-            ("Reserved0", 42), ("Reserved1", 43), ("Reserved2", 44), ("StepMs", 48), ("CollideMs", 56),
+            ("Reserved0", 42), ("Reserved1", 43), ("Refits", 44), ("StepMs", 48), ("CollideMs", 56),
             ("IntegrateMs", 64));
 
         [Fact]
@@ -340,6 +340,7 @@ namespace Drape.Tests
             new object[] { "drape_result", typeof(ResultCode) },
             new object[] { "drape_layout", typeof(Layout) },
             new object[] { "drape_proxy_rule", typeof(ProxyRule) },
+            new object[] { "drape_garment_fit", typeof(GarmentFit) },
             new object[] { "drape_tracking_state", typeof(TrackingState) },
             new object[] { "drape_filter", typeof(Filter) },
             new object[] { "drape_sex", typeof(Sex) },

@@ -89,6 +89,17 @@ namespace Drape
         Drape = 1,
     }
 
+    /// <summary>drape_garment_fit: what proportions garments are cut for.</summary>
+    public enum GarmentFit : int
+    {
+        /// <summary>DRAPE_GARMENT_FIT_SKELETON: the tracked person's. Once the tracker has calibrated the bone
+        /// lengths, every garment is cut again for their bones and torso (GarmentStats.Refits counts it;
+        /// particles and triangles stay, the rest shape changes). The default.</summary>
+        Skeleton = 0,
+        /// <summary>DRAPE_GARMENT_FIT_SHAPE: the body shape's standard proportions only; no refit at calibration.</summary>
+        Shape = 1,
+    }
+
     /// <summary>drape_sex.</summary>
     public enum Sex : int
     {
@@ -270,8 +281,8 @@ namespace Drape
         public float TeleportDistanceM;
         /// <summary>proxy_rule (int32_t in C); default <see cref="Drape.ProxyRule.Drape"/>.</summary>
         public ProxyRule ProxyRule;
-        /// <summary>reserved: 0.</summary>
-        public uint Reserved;
+        /// <summary>garment_fit (int32_t in C); default <see cref="Drape.GarmentFit.Skeleton"/>.</summary>
+        public GarmentFit GarmentFit;
 
         /// <summary>The library's defaults (drape_context_desc_init).</summary>
         public static unsafe ContextDesc CreateDefault()
@@ -666,8 +677,9 @@ namespace Drape
         public byte Reserved0;
         /// <summary>reserved1.</summary>
         public byte Reserved1;
-        /// <summary>reserved2.</summary>
-        public uint Reserved2;
+        /// <summary>refits: times the garment was cut again (a body shape change, the skeleton's calibration:
+        /// <see cref="Drape.GarmentFit"/>); its rest shape changes then, nothing else.</summary>
+        public uint Refits;
         /// <summary>step_ms: wall time of the garment's last step.</summary>
         public double StepMs;
         /// <summary>collide_ms: of which ellipsoid collision; 0 on the OpenCL backend, where collision

@@ -136,6 +136,21 @@ typedef enum drape_proxy_rule {
   DRAPE_PROXY_RULE_FORCE32 = 0x7fffffff
 } drape_proxy_rule;
 
+/* What proportions garments are cut for (drape_context_desc.garment_fit). */
+typedef enum drape_garment_fit {
+  /* The tracked person's. Until the tracker has calibrated the bone lengths (calibration_frames),
+   * garments are cut for the body shape's standard proportions; then every garment is cut again
+   * for this person: the rest pose takes their bone lengths and the geometry of their torso (spine,
+   * hip and shoulder joints), and the garments are refitted to it as after a shape change
+   * (drape_garment_stats.refits counts it; particles and triangles stay, the rest shape changes).
+   * No refit when the person's rest pose is within 1 cm of the standard one. Default. */
+  DRAPE_GARMENT_FIT_SKELETON = 0,
+  /* The body shape's standard proportions only (drape_context_set_body_shape), whatever the
+   * skeleton: no refit at calibration. */
+  DRAPE_GARMENT_FIT_SHAPE = 1,
+  DRAPE_GARMENT_FIT_FORCE32 = 0x7fffffff
+} drape_garment_fit;
+
 typedef struct drape_context_desc {
   uint32_t struct_size;          /* sizeof(drape_context_desc), set by drape_context_desc_init */
   uint32_t ring_points;          /* K, points per feature ring: multiple of 4 in [8, 256]; 20 */
@@ -155,7 +170,7 @@ typedef struct drape_context_desc {
                                     frame's dt) is reported as a teleport; (0, 100]; 0.5 */
   int32_t proxy_rule;            /* drape_proxy_rule: how tracking ellipsoids are built;
                                     default DRAPE_PROXY_RULE_DRAPE */
-  uint32_t reserved;             /* must be 0 (else DRAPE_ERROR_INVALID_ARGUMENT) */
+  int32_t garment_fit;           /* drape_garment_fit; default DRAPE_GARMENT_FIT_SKELETON (0) */
 } drape_context_desc;
 
 /* Fills `desc` with defaults and struct_size. */
@@ -571,7 +586,9 @@ typedef struct drape_garment_stats {
   uint8_t teleport_reset;   /* 1 if the last step carried the garment across a teleport */
   uint8_t nan_reset;        /* 1 if the last step had to restore the garment (please report) */
   uint8_t reserved0, reserved1;
-  uint32_t reserved2;
+  uint32_t refits;          /* times the garment was cut again (a body shape change, the skeleton's
+                               calibration: drape_garment_fit); its rest shape
+                               (drape_garment_read_rest_positions) changes then, nothing else */
   double step_ms;           /* wall time of the garment's last step */
   double collide_ms;        /* of which ellipsoid collision; 0 on the OpenCL backend, where
                                collision runs inside the device frame (docs/opencl.md) */

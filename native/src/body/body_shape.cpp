@@ -1,5 +1,6 @@
 #include "body/body_shape.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -111,6 +112,87 @@ SkeletonPose restPose(const ResolvedShape& shape, float arm_down_deg) {
       p.position[idx(chain[k])] = p.position[idx(chain[k - 1])] + dir * lengths[k - 1];
       p.state[idx(chain[k])] = TrackingState::Tracked;
     }
+  }
+  return p;
+}
+
+namespace {
+
+bool isTorsoJoint(int j) {
+  return j <= idx(Joint::Head) || j == idx(Joint::ShoulderL) || j == idx(Joint::ShoulderR) || j == idx(Joint::HipL) ||
+         j == idx(Joint::HipR);
+}
+
+// World -> rest-pose axes for a pose's pelvis: up along pelvis -> spine-shoulder, right along
+// hip L -> hip R (the rest pose faces -Z). False for a collapsed torso.
+bool pelvisFrame(const SkeletonPose& p, Mat3& to_rest) {
+  const auto& q = p.position;
+  const Vec3 up = q[idx(Joint::SpineShoulder)] - q[idx(Joint::Pelvis)];
+  Vec3 right = q[idx(Joint::HipR)] - q[idx(Joint::HipL)];
+  right -= right.dot(up) / std::max(up.squaredNorm(), 1e-12f) * up;
+  if (!(up.norm() > 0.05f) || !(right.norm() > 0.02f)) return false;
+  Mat3 f;  // columns: right, up, back
+  f.col(0) = right.normalized();
+  f.col(1) = up.normalized();
+  f.col(2) = f.col(0).cross(f.col(1));
+  to_rest = f.transpose();
+  return to_rest.allFinite();
+}
+
+}  // namespace
+
+SkeletonPose restPoseWithBones(const ResolvedShape& shape, float arm_down_deg,
+                               const std::array<float, kBoneCount>& lengths, const SkeletonPose* torso) {
+  const SkeletonPose rest = restPose(shape, arm_down_deg);
+  SkeletonPose p = rest;
+  // The torso's own geometry (spine, hip and shoulder joints) from `torso`, in its pelvis' frame.
+  Mat3 toRest = Mat3::Identity();
+  const bool useTorso = torso != nullptr && pelvisFrame(*torso, toRest);
+  for (int b = 0; b < kBoneCount; ++b) {  // parents come first (kJointParent's order)
+    const int c = boneChild(b), pa = boneParent(b);
+    Vec3 bone = rest.position[static_cast<size_t>(c)] - rest.position[static_cast<size_t>(pa)];
+    if (useTorso && isTorsoJoint(c)) {
+      // A torso bone more than 45 degrees off the standard pose's is not a build but bad data (a
+      // joint lost or flipped): the standard direction then.
+      const Vec3 d = toRest * (torso->position[static_cast<size_t>(c)] - torso->position[static_cast<size_t>(pa)]);
+      if (d.norm() > 1e-3f && d.normalized().dot(bone.normalized()) > std::cos(0.25f * kPi))
+        bone = d.normalized() * bone.norm();
+    }
+    const float canonical = bone.norm();
+    const float l = lengths[static_cast<size_t>(b)];
+    const float use = std::isfinite(l) && l >= 0.01f ? std::clamp(l, 0.25f * canonical, 4.0f * canonical) : canonical;
+    p.position[static_cast<size_t>(c)] =
+        p.position[static_cast<size_t>(pa)] + (canonical > 0.0f ? Vec3(bone * (use / canonical)) : bone);
+  }
+  return p;
+}
+
+void TorsoAverage::clear() {
+  sum_.fill(Vec3::Zero());
+  count_ = 0;
+}
+
+void TorsoAverage::add(const SkeletonPose& pose) {
+  Mat3 toRest;
+  if (!pelvisFrame(pose, toRest)) return;
+  for (int j = 1; j < kJointCount; ++j) {
+    if (!isTorsoJoint(j)) continue;
+    const Vec3 d = toRest * (pose.position[static_cast<size_t>(j)] - pose.position[static_cast<size_t>(kJointParent[static_cast<size_t>(j)])]);
+    if (d.norm() > 1e-4f && d.allFinite()) sum_[static_cast<size_t>(j)] += d.normalized();
+  }
+  ++count_;
+}
+
+SkeletonPose TorsoAverage::mean() const {
+  // Rest-pose axes already: the pelvis frame of this pose is the identity (up to the spine's and
+  // hips' own average directions).
+  SkeletonPose p;
+  p.position.fill(Vec3::Zero());
+  p.state.fill(TrackingState::Tracked);
+  for (int j = 1; j < kJointCount; ++j) {
+    const Vec3 d = sum_[static_cast<size_t>(j)];
+    p.position[static_cast<size_t>(j)] =
+        p.position[static_cast<size_t>(kJointParent[static_cast<size_t>(j)])] + (d.norm() > 1e-6f ? Vec3(d.normalized()) : Vec3::Zero());
   }
   return p;
 }

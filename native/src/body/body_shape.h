@@ -44,4 +44,29 @@ ResolvedShape resolveShape(const BodyShapeInput& in);
 // Used to fix the mesh topology's seam alignment and for synthetic tests.
 SkeletonPose restPose(const ResolvedShape& shape, float arm_down_deg = 35.0f);
 
+// The same standing pose with the person's own bone lengths (SkeletonTracker::boneLengths()
+// once calibrated): every bone keeps the rest pose's direction and takes the measured length,
+// top-down from the pelvis, so the rings, ellipsoids and the garments cut on this pose have the
+// tracked skeleton's proportions. A length that is not finite or under 1 cm (a bone the sensor
+// never saw) keeps the rest pose's; the others are held within [0.25, 4] times it.
+SkeletonPose restPoseWithBones(const ResolvedShape& shape, float arm_down_deg,
+                               const std::array<float, kBoneCount>& lengths, const SkeletonPose* torso = nullptr);
+
+// The person's torso geometry averaged over many poses (the tracker's calibration window): the
+// direction of each torso bone (spine, neck, head, hip and shoulder joints) in the frame of the
+// pelvis, so one bent or noisy frame does not shape the garments. mean() is a pose with those
+// directions (unit bones from the origin) for restPoseWithBones; empty() until a pose was added.
+class TorsoAverage {
+ public:
+  TorsoAverage() { clear(); }  // (an Eigen vector is not zeroed by {})
+  void clear();
+  void add(const SkeletonPose& pose);  // poses without a usable pelvis frame are skipped
+  bool empty() const { return count_ == 0; }
+  SkeletonPose mean() const;
+
+ private:
+  std::array<Vec3, kJointCount> sum_;
+  int count_ = 0;
+};
+
 }  // namespace drape

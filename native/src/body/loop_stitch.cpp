@@ -15,11 +15,13 @@ void stitchEqual(const uint32_t* L, const uint32_t* U, int n, bool closed, std::
   }
 }
 
-void stitchLoops(const Loop& L, Loop U, const std::vector<Vec3>& rest, std::vector<uint32_t>& out) {
+void stitchLoops(const Loop& L, Loop U, const std::vector<Vec3>& rest, std::vector<uint32_t>& out, int* rotation) {
   const int n = static_cast<int>(L.size()), m = static_cast<int>(U.size());
   int best = 0;
   float bestCost = std::numeric_limits<float>::max();
-  for (int o = 0; o < m; ++o) {
+  const bool given = rotation != nullptr && *rotation >= 0 && *rotation < m;
+  if (given) best = *rotation;
+  for (int o = 0; o < m && !given; ++o) {
     float cost = 0.0f;
     for (int i = 0; i < n; ++i) {
       const int j = (o + static_cast<int>(std::lround(static_cast<double>(i) * m / n))) % m;
@@ -30,6 +32,7 @@ void stitchLoops(const Loop& L, Loop U, const std::vector<Vec3>& rest, std::vect
       best = o;
     }
   }
+  if (rotation) *rotation = best;
   std::rotate(U.begin(), U.begin() + best, U.end());
   int i = 0, j = 0;
   while (i < n || j < m) {

@@ -19,7 +19,10 @@ void stitchEqual(const uint32_t* L, const uint32_t* U, int n, bool closed, std::
 
 // Closed loops of different sizes: advance along whichever loop is behind in normalised
 // parameter ("zipper"). U is first rotated so that its start lies nearest L's start, measured on
-// `positions`, which keeps the stitch from twisting.
-void stitchLoops(const Loop& L, Loop U, const std::vector<Vec3>& positions, std::vector<uint32_t>& out);
+// `positions`, which keeps the stitch from twisting. `rotation` (optional): when it points at a
+// value >= 0 that rotation of U is used as given; otherwise the chosen one is written there (a
+// garment cut again for another body replays its first cut's choices: garment_templates.h).
+void stitchLoops(const Loop& L, Loop U, const std::vector<Vec3>& positions, std::vector<uint32_t>& out,
+                 int* rotation = nullptr);
 
 }  // namespace drape

@@ -210,16 +210,16 @@ drape_result toFitParams(const char* fn, const drape_mesh_fit* fit, drape::ObjFi
   return DRAPE_OK;
 }
 
-// Dresses `mesh` on the context's rest body and hands out a handle.
-drape_result adopt(const char* fn, Context& ctx, const drape::GarmentMesh& mesh, const drape_garment_desc& d,
-                   const drape::GarmentSimParams& sim, drape_garment** out, bool cut_from_dressed) {
+drape::TopologyParams topologyFrom(const drape_garment_desc& d) {
   drape::TopologyParams tp;
   tp.area_density = d.area_density;
   tp.max_tethers_per_particle = static_cast<int>(d.max_tethers);
-  std::string err;
-  auto g = GarmentSim::create(mesh, tp, static_cast<drape::ClothSolverKind>(d.solver), sim, d.dress_time_s,
-                              ctx.restBody(), ctx.restEllipsoids(), ctx.restEllipsoidChains(), err,
-                              cut_from_dressed);
+  return tp;
+}
+
+// Hands out a handle for a garment dressed on the context's rest body (null: `err` says why).
+drape_result adoptCreated(const char* fn, Context& ctx, std::unique_ptr<GarmentSim> g, const std::string& err,
+                          drape_garment** out) {
   if (!g) return fail(DRAPE_ERROR_INVALID_ARGUMENT, std::string(fn) + ": " + err);
   GarmentSim* raw = g.get();
   void* token = registerHandle(HandleKind::Garment, raw);
@@ -228,6 +228,16 @@ drape_result adopt(const char* fn, Context& ctx, const drape::GarmentMesh& mesh,
   ctx.adoptGarment(std::move(g));
   *out = static_cast<drape_garment*>(token);
   return DRAPE_OK;
+}
+
+// Dresses `mesh` on the context's rest body and hands out a handle.
+drape_result adopt(const char* fn, Context& ctx, const drape::GarmentMesh& mesh, const drape_garment_desc& d,
+                   const drape::GarmentSimParams& sim, drape_garment** out, bool cut_from_dressed) {
+  std::string err;
+  auto g = GarmentSim::create(mesh, topologyFrom(d), static_cast<drape::ClothSolverKind>(d.solver), sim,
+                              d.dress_time_s, ctx.restBody(), ctx.restEllipsoids(), ctx.restEllipsoidChains(), err,
+                              cut_from_dressed);
+  return adoptCreated(fn, ctx, std::move(g), err, out);
 }
 
 drape_result addFitted(const char* fn, Context& ctx, const drape::ObjMesh& obj, const drape_mesh_fit* fit,
@@ -331,11 +341,11 @@ DRAPE_API drape_result DRAPE_CALL drape_context_add_garment_template(drape_conte
     tp.target_particles = static_cast<int>(t.particles);
     tp.ease_m = t.ease_m;
     tp.length_scale = t.length_scale;
-    drape::GarmentMesh mesh;
     std::string err;
-    if (!drape::makeGarmentTemplate(ctx->restBody(), tp, mesh, err))
-      return fail(DRAPE_ERROR_INVALID_ARGUMENT, std::string(fn) + ": " + err);
-    return adopt(fn, *ctx, mesh, d, sim, out_garment, /*cut_from_dressed=*/false);
+    auto g = GarmentSim::createTemplate(tp, topologyFrom(d), static_cast<drape::ClothSolverKind>(d.solver), sim,
+                                        d.dress_time_s, ctx->restBody(), ctx->restEllipsoids(),
+                                        ctx->restEllipsoidChains(), err);
+    return adoptCreated(fn, *ctx, std::move(g), err, out_garment);
   });
 }
 
@@ -549,6 +559,7 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_get_stats(drape_garment* handle,
     o.steps = garment->steps();
     o.teleport_reset = s.teleport_reset ? 1 : 0;
     o.nan_reset = s.nan_reset ? 1 : 0;
+    o.refits = garment->refits();
     o.step_ms = s.total_ms;
     o.collide_ms = s.collide_ms;
     o.integrate_ms = s.total_ms - s.collide_ms;

@@ -3,6 +3,7 @@
 #include "body/mesh_metrics.h"
 #include "skeleton/layouts.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -22,6 +23,11 @@ double msSince(Clock::time_point t0) {
 // cut in the usual 35-degree A-pose (median per-frame P99 stretch 18-34 % against 30-38 %,
 // docs/garments.md).
 constexpr float kGarmentRestArmDownDeg = 65.0f;
+
+// A person whose rest pose (their bones, their torso) is within this of the one the garments were
+// cut on keeps the garments as they are at calibration: a refit re-dresses every garment (a visible
+// change, and ~10-20 ms at 2 000 particles) for a difference the cloth absorbs anyway.
+constexpr float kRefitBelowM = 0.01f;
 
 // Coordinates beyond this are not a person in front of a sensor; rejecting them keeps 1e30-style
 // garbage from turning into Inf inside the filters.
@@ -61,9 +67,9 @@ drape_result validateContextDesc(const drape_context_desc& d, std::string& err) 
   } else if ((r = range("jitter_radius_m", d.jitter_radius_m, 0.0f, 10.0f)) != DRAPE_OK) {
   } else if ((r = range("max_deviation_m", d.max_deviation_m, 0.0f, 10.0f)) != DRAPE_OK) {
   } else if ((r = range("teleport_distance_m", d.teleport_distance_m, 1e-6f, 100.0f)) != DRAPE_OK) {
-  } else if (d.reserved != 0) {
-    s << "context desc: reserved must be 0";
-    r = DRAPE_ERROR_INVALID_ARGUMENT;
+  } else if (d.garment_fit != DRAPE_GARMENT_FIT_SKELETON && d.garment_fit != DRAPE_GARMENT_FIT_SHAPE) {
+    s << "context desc: garment_fit = " << d.garment_fit << " is not 0 (skeleton) or 1 (shape)";
+    r = DRAPE_ERROR_OUT_OF_RANGE;
   } else if (d.proxy_rule != DRAPE_PROXY_RULE_PAPER && d.proxy_rule != DRAPE_PROXY_RULE_DRAPE) {
     s << "context desc: proxy_rule = " << d.proxy_rule << " is not 0 (paper) or 1 (drape)";
     r = DRAPE_ERROR_OUT_OF_RANGE;
@@ -115,28 +121,11 @@ drape_result Context::setShape(const BodyShapeInput& in, std::string& err) {
   useShape(resolveShape(in));
   // Garments are refitted to the new body (GarmentSim::refitted, docs/garments.md "Body shape
   // changes"): all of them or, when one cannot be dressed on it, none and the old shape back.
-  std::vector<std::unique_ptr<GarmentSim>> refits;
   // The same measurements again (a host that sets the shape every frame) change nothing.
-  const size_t refit_count = before.m == shape_.m ? 0 : garments_.size();
-  refits.reserve(refit_count);
-  for (size_t i = 0; i < refit_count; ++i) {
-    std::string why;
-    refits.push_back(garments_[i]->refitted(restBody(), restEllipsoids(), restEllipsoidChains(), why));
-    if (!refits.back()) {
-      useShape(before);
-      err = "garment " + std::to_string(i) + " could not be dressed on the new body (" + why +
-            "); the previous shape is kept";
-      return DRAPE_ERROR_INVALID_ARGUMENT;
-    }
-  }
-  ReachParams rp;
-  rp.margin_m = options_.reach_margin_m;
-  for (size_t i = 0; i < refit_count; ++i) {
-    GarmentSim& g = *garments_[i];
-    g.replaceWith(std::move(*refits[i]));
-    adaptive_.removeGarment(&g);
-    adaptive_.addGarment(&g, garmentReach(g, rp));
-    applyBackend(g);
+  if (before.m != shape_.m && !refitGarments(err)) {
+    useShape(before);
+    err += "; the previous shape is kept";
+    return DRAPE_ERROR_INVALID_ARGUMENT;
   }
   shapeDirty_ = true;
   volumeDirty_ = true;
@@ -144,6 +133,67 @@ drape_result Context::setShape(const BodyShapeInput& in, std::string& err) {
   wakeAll();
   proxyBounds_.clear();
   return DRAPE_OK;
+}
+
+SkeletonPose Context::garmentRestPose() const {
+  return fitBones_ ? restPoseWithBones(shape_, kGarmentRestArmDownDeg, fittedBones_, &fittedTorso_)
+                   : restPose(shape_, kGarmentRestArmDownDeg);
+}
+
+void Context::fitGarmentsToSkeleton() {
+  // The garments so far were cut for other proportions (the shape's standard ones, or a previous
+  // calibration's): cut them again for this person, when their rest pose is another. Should a
+  // garment fail to dress on that body, every garment stays as it was, on the previous rest body,
+  // until the next calibration.
+  fittedCalibration_ = tracker_.calibrationCount();
+  const SkeletonPose torso = torsoAverage_.empty() ? tracker_.pose() : torsoAverage_.mean();
+  torsoAverage_.clear();  // the next calibration (a tracker reset) averages its own window
+  const SkeletonPose fitted = restPoseWithBones(shape_, kGarmentRestArmDownDeg, tracker_.boneLengths(), &torso);
+  restBody();  // restPoseUsed_
+  float moved = 0.0f;
+  for (int j = 0; j < kJointCount; ++j)
+    moved = std::max(moved, (fitted.position[static_cast<size_t>(j)] - restPoseUsed_.position[static_cast<size_t>(j)]).norm());
+  if (!(moved >= kRefitBelowM)) return;  // this person has the proportions the garments were cut for
+  const bool before = fitBones_;
+  const std::array<float, kBoneCount> beforeBones = fittedBones_;
+  const SkeletonPose beforeTorso = fittedTorso_;
+  fitBones_ = true;
+  fittedBones_ = tracker_.boneLengths();
+  fittedTorso_ = torso;
+  restBody_.reset();
+  std::string err;
+  if (!refitGarments(err)) {
+    fitBones_ = before;
+    fittedBones_ = beforeBones;
+    fittedTorso_ = beforeTorso;
+    restBody_.reset();
+    ++boneFitFailures_;
+  }
+  wakeAll();
+  proxyBounds_.clear();
+}
+
+bool Context::refitGarments(std::string& err) {
+  std::vector<std::unique_ptr<GarmentSim>> refits;
+  refits.reserve(garments_.size());
+  for (size_t i = 0; i < garments_.size(); ++i) {
+    std::string why;
+    refits.push_back(garments_[i]->refitted(restBody(), restEllipsoids(), restEllipsoidChains(), why));
+    if (!refits.back()) {
+      err = "garment " + std::to_string(i) + " could not be dressed on the new body (" + why + ")";
+      return false;
+    }
+  }
+  ReachParams rp;
+  rp.margin_m = options_.reach_margin_m;
+  for (size_t i = 0; i < garments_.size(); ++i) {
+    GarmentSim& g = *garments_[i];
+    g.replaceWith(std::move(*refits[i]));
+    adaptive_.removeGarment(&g);
+    adaptive_.addGarment(&g, garmentReach(g, rp));
+    applyBackend(g);
+  }
+  return true;
 }
 
 drape_result Context::pushFrame(const drape_skeleton_frame& f, std::string& err) {
@@ -247,6 +297,8 @@ drape_result Context::update(std::string& err) {
       return DRAPE_ERROR_INTERNAL;
     }
   }
+  // The torso over the calibration window, for the garments' cut (fitGarmentsToSkeleton).
+  if (desc_.garment_fit == DRAPE_GARMENT_FIT_SKELETON && newPose && !tracker_.calibrated()) torsoAverage_.add(pose);
   finishFrameCounters();
   skips_.updates = updates_;
   // A body that moved wakes the garments before anything is built for the frame.
@@ -323,9 +375,13 @@ const BodyModel& Context::restBody() {
     bp.ring_points = static_cast<int>(desc_.ring_points);
     bp.rings_per_segment = static_cast<int>(desc_.rings_per_segment);
     auto b = std::make_unique<BodyModel>(shape_, bp);
-    const SkeletonPose pose = restPose(shape_, kGarmentRestArmDownDeg);
+    const SkeletonPose pose = garmentRestPose();
     b->update(pose);
-    restProxies_ = ProxyBuilder(static_cast<ProxyRule>(desc_.proxy_rule));
+    restPoseUsed_ = pose;
+    // The tracked body's builder, so the ellipsoids come in the same count and order as every
+    // frame's (the plan of sub-rings is made on a builder's first build and depends on the
+    // proportions: a fresh builder on a body with the person's bones can plan other ones).
+    restProxies_ = proxies_;
     restProxies_.build(*b, pose);
     restChains_.clear();
     for (const ProxySource& src : restProxies_.sources()) restChains_.push_back(static_cast<int>(src.chain));
@@ -390,6 +446,9 @@ drape_result Context::checkStep(float dt, std::string& err) const {
 
 drape_result Context::beginStep(float dt, std::string& err) {
   if (drape_result r = update(err)) return r;
+  if (desc_.garment_fit == DRAPE_GARMENT_FIT_SKELETON && tracker_.calibrated() &&
+      tracker_.calibrationCount() != fittedCalibration_)
+    fitGarmentsToSkeleton();
   stepT0_ = Clock::now();
   // Woken or new garments, or new options, since the frame's ellipsoids were built.
   if (reachDirty_ && updated_) buildProxies(tracker_.pose());

@@ -94,6 +94,21 @@ class Context {
   void refreshBvh();
 
   std::unique_ptr<BodyModel> restBody_;  // rest pose of the current shape, for garments
+  // Garments are cut on the rest pose with the person's bones once the tracker has calibrated them
+  // (DRAPE_GARMENT_FIT_SKELETON; before that, the shape's standard proportions): fitBones_ says which restBody() builds (garmentRestPose), from
+  // the bone lengths and torso pose of the calibration fitted last; restPoseUsed_ is its pose.
+  bool fitBones_ = false;
+  std::array<float, kBoneCount> fittedBones_{};
+  SkeletonPose fittedTorso_{};
+  TorsoAverage torsoAverage_;  // the torso over the calibration window
+  SkeletonPose restPoseUsed_{};
+  uint32_t fittedCalibration_ = 0;  // the tracker's calibrationCount() last seen
+  uint32_t boneFitFailures_ = 0;    // calibrations whose refit failed (garments kept as they were)
+  SkeletonPose garmentRestPose() const;
+  void fitGarmentsToSkeleton();
+  // Refits every garment to restBody() (after a shape change or the tracker's calibration): all
+  // of them or, when one cannot be dressed on the new body, none (err says which and why).
+  bool refitGarments(std::string& err);
   ProxyBuilder restProxies_;
   std::vector<int> restChains_;
   std::vector<std::unique_ptr<GarmentSim>> garments_;

@@ -279,6 +279,25 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
   return g;
 }
 
+std::unique_ptr<GarmentSim> GarmentSim::createTemplate(const GarmentTemplateParams& tmpl, const TopologyParams& topo,
+                                                       ClothSolverKind solver, const GarmentSimParams& params,
+                                                       float dress_time_s, const BodyModel& body_rest,
+                                                       const std::vector<Ellipsoid>& rest_ellipsoids,
+                                                       const std::vector<int>& ellipsoid_chains, std::string& err) {
+  GarmentMesh mesh;
+  TemplateLayout layout;
+  if (!makeGarmentTemplate(body_rest, tmpl, mesh, err, &layout)) return nullptr;
+  std::unique_ptr<GarmentSim> g =
+      create(mesh, topo, solver, params, dress_time_s, body_rest, rest_ellipsoids, ellipsoid_chains, err);
+  if (!g) return nullptr;
+  auto origin = std::make_shared<Origin>(*g->origin_);
+  origin->from_template = true;
+  origin->tmpl = tmpl;
+  origin->layout = std::move(layout);
+  g->origin_ = std::move(origin);
+  return g;
+}
+
 std::unique_ptr<GarmentSim> GarmentSim::refitted(const BodyModel& body_rest,
                                                  const std::vector<Ellipsoid>& rest_ellipsoids,
                                                  const std::vector<int>& ellipsoid_chains,
@@ -287,6 +306,21 @@ std::unique_ptr<GarmentSim> GarmentSim::refitted(const BodyModel& body_rest,
   if (o.rest_rings.size() != body_rest.rings().size()) {
     err = "the new body has another ring layout than the one the garment was made on";
     return nullptr;
+  }
+  if (o.from_template) {
+    // The template made again for this body with the first cut's layout: the particles, triangles
+    // and attachments of the garment, placed as a template made for this body places them (a
+    // better cut than carrying the old one by ring skinning: docs/garments.md). Should the body
+    // be too unlike the first for the layout, the ring skinning below does it.
+    GarmentMesh mesh;
+    std::string why;
+    if (makeGarmentTemplate(body_rest, o.tmpl, mesh, why, nullptr, &o.layout) && mesh.indices == o.mesh.indices &&
+        mesh.positions.size() == o.mesh.positions.size() && mesh.pinned == o.mesh.pinned) {
+      std::unique_ptr<GarmentSim> g = create(mesh, o.topology, kind_, params_, o.dress_time_s, body_rest,
+                                             rest_ellipsoids, ellipsoid_chains, err);
+      if (g) g->origin_ = origin_;
+      return g;
+    }
   }
   GarmentMesh mesh = o.mesh;
   RingSkin skin;
@@ -305,8 +339,9 @@ void GarmentSim::replaceWith(GarmentSim&& fresh) {
   void* const token = api_token;
   void* const owner = api_owner;
   const uint64_t steps = steps_;
-  const uint32_t jumps = jump_restores_, bursts = burst_restores_;
+  const uint32_t jumps = jump_restores_, bursts = burst_restores_, refits = refits_;
   *this = std::move(fresh);
+  refits_ = refits + 1;
   api_token = token;
   api_owner = owner;
   steps_ = steps;

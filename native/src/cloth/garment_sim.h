@@ -101,6 +101,13 @@ class GarmentSim {
                                             const std::vector<Ellipsoid>& rest_ellipsoids,
                                             const std::vector<int>& ellipsoid_chains,
                                             std::string& err, bool cut_from_dressed = false);
+  // A template garment: makeGarmentTemplate on body_rest, then create(). It remembers the template
+  // and its layout, so refitted() cuts it again as that template on the new body.
+  static std::unique_ptr<GarmentSim> createTemplate(const GarmentTemplateParams& tmpl, const TopologyParams& topo,
+                                                    ClothSolverKind solver, const GarmentSimParams& params,
+                                                    float dress_time_s, const BodyModel& body_rest,
+                                                    const std::vector<Ellipsoid>& rest_ellipsoids,
+                                                    const std::vector<int>& ellipsoid_chains, std::string& err);
   ~GarmentSim();
 
   // Refitting to a new body shape (the host changed the person's height, weight or girths while
@@ -117,8 +124,9 @@ class GarmentSim {
   std::unique_ptr<GarmentSim> refitted(const BodyModel& body_rest, const std::vector<Ellipsoid>& rest_ellipsoids,
                                        const std::vector<int>& ellipsoid_chains, std::string& err) const;
   // Takes over `fresh` (from refitted()) and keeps what identifies this garment to its owner: the
-  // C ABI token and owner, its step count and glitch counters.
+  // C ABI token and owner, its step count and glitch counters; counts the refit.
   void replaceWith(GarmentSim&& fresh);
+  uint32_t refits() const { return refits_; }
 
   bool setParams(const GarmentSimParams& params, std::string& err);
   const GarmentSimParams& params() const { return params_; }
@@ -264,6 +272,10 @@ class GarmentSim {
     TopologyParams topology;
     float dress_time_s = 0.0f;
     std::vector<RingPose> rest_rings;
+    // A template garment (createTemplate): cut again as that template, with the same layout.
+    bool from_template = false;
+    GarmentTemplateParams tmpl;
+    TemplateLayout layout;
   };
   std::shared_ptr<const Origin> origin_;
   GarmentSim& operator=(GarmentSim&&) noexcept;  // replaceWith
@@ -299,6 +311,7 @@ class GarmentSim {
   const std::vector<Ellipsoid>& pickReachable(const std::vector<Ellipsoid>& all, std::vector<Ellipsoid>& out) const;
   GarmentStepStats last_;
   uint64_t steps_ = 0;
+  uint32_t refits_ = 0;
 };
 
 }  // namespace drape

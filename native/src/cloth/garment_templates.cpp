@@ -96,8 +96,9 @@ int roundTo(float v, int multiple, int minimum) {
   return std::max(minimum, k);
 }
 
-// Sections along a path s in [0, 1], evenly spaced in arc length by about h (at least 2).
-std::vector<Sec> samplePath(const std::function<Sec(float)>& path, float h) {
+// Sections along a path s in [0, 1], evenly spaced in arc length by about h (at least 2); `count`
+// may replace that number (Builder::count).
+std::vector<Sec> samplePath(const std::function<Sec(float)>& path, float h, const std::function<int(int)>& count) {
   constexpr int kFine = 128;
   std::vector<float> cum(kFine + 1, 0.0f);
   Vec3 prev = path(0.0f).c;
@@ -107,7 +108,7 @@ std::vector<Sec> samplePath(const std::function<Sec(float)>& path, float h) {
     prev = c;
   }
   const float L = cum[kFine];
-  const int rings = std::max(2, static_cast<int>(std::lround(L / h)) + 1);
+  const int rings = std::max(2, count(std::max(2, static_cast<int>(std::lround(L / h)) + 1)));
   std::vector<Sec> out;
   for (int r = 0; r < rings; ++r) {
     const float target = L * static_cast<float>(r) / static_cast<float>(rings - 1);
@@ -132,8 +133,25 @@ class Builder {
     buildEnclosure();
   }
 
+  // Record (into `out`) or replay (from `in`) the build's choices; replay() is false once the
+  // replayed build asked for something the layout does not have.
+  void setLayout(TemplateLayout* out, const TemplateLayout* in) {
+    rec_ = out;
+    play_ = in;
+  }
+  bool replayed() const {
+    return !play_ || (ok_ && nextCount_ == play_->counts.size() && nextRotation_ == play_->rotations.size());
+  }
+
   void build(float h, GarmentMesh& m) {
     m = GarmentMesh{};
+    nextCount_ = nextRotation_ = 0;
+    ok_ = true;
+    if (rec_) {
+      rec_->counts.clear();
+      rec_->rotations.clear();
+      rec_->h = h;
+    }
     switch (p_.kind) {
       case GarmentKind::TShirt: upper(h, 0.05f * p_.length_scale, false, 0.5f * p_.length_scale, m); break;
       case GarmentKind::LongSleeve: upper(h, 0.05f * p_.length_scale, false, std::min(2.0f, 1.9f * p_.length_scale), m); break;
@@ -182,6 +200,35 @@ class Builder {
   void finishPins(GarmentMesh& m) const { pinOffsetsFromPositions(body_, m); }
 
  private:
+  TemplateLayout* rec_ = nullptr;
+  const TemplateLayout* play_ = nullptr;
+  size_t nextCount_ = 0, nextRotation_ = 0;
+  bool ok_ = true;
+  // Every count the build derives from the body goes through here: recorded, or replayed.
+  int count(int computed) {
+    if (play_) {
+      if (nextCount_ >= play_->counts.size() || play_->counts[nextCount_] < 1) {
+        ok_ = false;
+        return computed;
+      }
+      return play_->counts[nextCount_++];
+    }
+    if (rec_) rec_->counts.push_back(computed);
+    return computed;
+  }
+  std::function<int(int)> counter() {
+    return [this](int v) { return count(v); };
+  }
+  void stitch(const Loop& L, const Loop& U, GarmentMesh& m) {
+    int rotation = -1;
+    if (play_) {
+      if (nextRotation_ < play_->rotations.size()) rotation = play_->rotations[nextRotation_++];
+      else ok_ = false;
+    }
+    stitchLoops(L, U, m.positions, m.indices, &rotation);
+    if (rec_) rec_->rotations.push_back(rotation);
+  }
+
   // An ellipsoid inflated by the clearance (refresh() gives its to_unit and bounds), computed once
   // per call: per particle and pass they were most of a template's build time. The box is the
   // bounds scaled by 1.01 about the centre: outside it |q|^2 > 1.0201, so the Newton loop (which
@@ -300,7 +347,7 @@ class Builder {
     const Sec T = chainSec(body_, Chain::Torso, uTop, e);
     const int ringN = body_.chainFirstRing(Chain::Head);
     const Sec N = ringSec(body_.rings()[static_cast<size_t>(ringN)], e);
-    const int K = roundTo(secPerimeter(T) / h, 8, 16);
+    const int K = count(roundTo(secPerimeter(T) / h, 8, 16));
     // v in [0, 1]: first the part below the hip (by length), then the torso by station u.
     const float below_len = hemDrop, above_len = (T.c - hip_.c).norm();
     const float split = below_len / (below_len + above_len);
@@ -308,12 +355,12 @@ class Builder {
       if (v < split) return below(hemDrop * (1.0f - v / split), aline);
       return chainSec(body_, Chain::Torso, uTop * (v - split) / (1.0f - split), e);
     };
-    const std::vector<Loop> torso = tube(m, samplePath(path, h), K);
+    const std::vector<Loop> torso = tube(m, samplePath(path, h, counter()), K);
     const Loop& Tl = torso.back();
     // Yoke rows between T and N (front and back arcs only).
     const int hq = K / 8;
     const float yokeLen = (N.c - T.c).norm() + 0.5f * (T.a - N.a);
-    const int R = std::max(1, static_cast<int>(std::lround(yokeLen / h)));
+    const int R = count(std::max(1, static_cast<int>(std::lround(yokeLen / h))));
     auto wrap = [K](int j) { return ((j % K) + K) % K; };
     std::vector<std::vector<uint32_t>> rows(static_cast<size_t>(R + 1), std::vector<uint32_t>(static_cast<size_t>(K), UINT32_MAX));
     for (int j = 0; j < K; ++j) rows[0][static_cast<size_t>(j)] = Tl[static_cast<size_t>(j)];
@@ -363,10 +410,10 @@ class Builder {
       for (int r = R - 1; r >= 1; --r) loop.push_back(rows[static_cast<size_t>(r)][static_cast<size_t>(wrap(from))]);
       const Chain arm = left ? Chain::ArmL : Chain::ArmR;
       const Sec s0 = chainSec(body_, arm, 0.0f, e);
-      const int Ka = roundTo(secPerimeter(s0) / h, 4, 8);
+      const int Ka = count(roundTo(secPerimeter(s0) / h, 4, 8));
       auto apath = [&](float v) { return chainSec(body_, arm, v * sleeveU, e); };
-      const std::vector<Loop> sleeve = tube(m, samplePath(apath, h), Ka);
-      stitchLoops(loop, sleeve.front(), m.positions, m.indices);
+      const std::vector<Loop> sleeve = tube(m, samplePath(apath, h, counter()), Ka);
+      stitch(loop, sleeve.front(), m);
       // Shoulder-seam top: the sleeve's first-ring points highest along the torso's up axis.
       const Vec3 up_axis = T.f.col(1);
       std::vector<std::pair<float, uint32_t>> byHeight;
@@ -407,8 +454,8 @@ class Builder {
       return chainSec(body_, Chain::Torso, uW * (v - split) / (1.0f - split), e);
     };
     const float perim = 0.5f * (secPerimeter(W) + secPerimeter(below(hem, true)));
-    const int K = roundTo(perim / h, 8, 16);
-    const std::vector<Loop> rings = tube(m, samplePath(path, h), K);
+    const int K = count(roundTo(perim / h, 8, 16));
+    const std::vector<Loop> rings = tube(m, samplePath(path, h, counter()), K);
     pinLoop(m, rings.back(), nearestRing(body_, Chain::Torso, 0.55f));
   }
 
@@ -416,15 +463,15 @@ class Builder {
     const float e = p_.ease_m;
     const int ringW = nearestRing(body_, Chain::Torso, 0.55f);
     const float uW = body_.stations()[static_cast<size_t>(ringW)].u;
-    const int K = roundTo(secPerimeter(hip_) / h, 8, 16);
+    const int K = count(roundTo(secPerimeter(hip_) / h, 8, 16));
     auto tpath = [&](float v) { return chainSec(body_, Chain::Torso, uW * v, e); };
-    const std::vector<Loop> torso = tube(m, samplePath(tpath, h), K);
+    const std::vector<Loop> torso = tube(m, samplePath(tpath, h, counter()), K);
     pinLoop(m, torso.back(), ringW);
     const Loop& P = torso.front();
     // Crotch bridge from the hip ring's front centre to its back centre, sagging between the legs.
     const Vec3 front = m.positions[P[0]], back = m.positions[P[static_cast<size_t>(K / 2)]];
     const float drop = body_.stations()[static_cast<size_t>(body_.chainFirstRing(Chain::LegL))].offset_m + e;
-    const int nb = std::max(1, static_cast<int>(std::lround((back - front).norm() / h)) - 1);
+    const int nb = count(std::max(1, static_cast<int>(std::lround((back - front).norm() / h)) - 1));
     Loop bridge;
     for (int b = 0; b < nb; ++b) {
       const float u = static_cast<float>(b + 1) / static_cast<float>(nb + 1);
@@ -434,9 +481,9 @@ class Builder {
     for (bool left : {false, true}) {
       const Chain leg = left ? Chain::LegL : Chain::LegR;
       const Sec s0 = chainSec(body_, leg, 0.0f, e);
-      const int Kl = roundTo(secPerimeter(s0) / h, 4, 8);
+      const int Kl = count(roundTo(secPerimeter(s0) / h, 4, 8));
       auto lpath = [&](float v) { return chainSec(body_, leg, v * uEnd, e); };
-      const std::vector<Loop> tubeRings = tube(m, samplePath(lpath, h), Kl);
+      const std::vector<Loop> tubeRings = tube(m, samplePath(lpath, h, counter()), Kl);
       Loop half;
       if (!left) {
         half.assign(P.begin(), P.begin() + K / 2 + 1);
@@ -447,7 +494,7 @@ class Builder {
         half.insert(half.end(), bridge.begin(), bridge.end());
       }
       std::reverse(half.begin(), half.end());
-      stitchLoops(half, tubeRings.front(), m.positions, m.indices);
+      stitch(half, tubeRings.front(), m);
     }
   }
 
@@ -464,8 +511,10 @@ class Builder {
 // shorter than the mesh spacing (0.1 mm next to 2 cm ones). Such an edge has no say in the shape,
 // but measured as stretch over its rest length it dominates every maximum, and its tiny mass
 // stiffens the solve. Merge the ends of every edge shorter than `tol` (union-find, the lower
-// index survives; a pinned end stays pinned) and drop triangles that collapse.
-void weldShortEdges(GarmentMesh& m, float tol) {
+// index survives; a pinned end stays pinned) and drop triangles that collapse. `roots` (optional):
+// receives each vertex's survivor, or with `replay` gives them (a cut for another body welds what
+// the first cut welded; false when they do not fit this mesh).
+bool weldShortEdges(GarmentMesh& m, float tol, std::vector<uint32_t>* roots = nullptr, bool replay = false) {
   const size_t n = m.positions.size();
   std::vector<uint32_t> parent(n);
   for (uint32_t i = 0; i < n; ++i) parent[i] = i;
@@ -473,19 +522,33 @@ void weldShortEdges(GarmentMesh& m, float tol) {
     while (parent[i] != i) i = parent[i] = parent[parent[i]];
     return i;
   };
-  const float tol2 = tol * tol;
   bool any = false;
-  for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
-    for (size_t e = 0; e < 3; ++e) {
-      const uint32_t a = m.indices[t + e], b = m.indices[t + (e + 1) % 3];
-      if ((m.positions[a] - m.positions[b]).squaredNorm() >= tol2) continue;
-      const uint32_t ra = root(a), rb = root(b);
-      if (ra == rb) continue;
-      parent[std::max(ra, rb)] = std::min(ra, rb);
-      any = true;
+  if (replay) {
+    if (!roots || roots->size() != n) return false;
+    for (uint32_t i = 0; i < n; ++i) {
+      const uint32_t r = (*roots)[i];
+      if (r > i || (*roots)[r] != r) return false;  // survivors are the lowest index of their group
+      parent[i] = r;
+      any = any || r != i;
+    }
+  } else {
+    const float tol2 = tol * tol;
+    for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
+      for (size_t e = 0; e < 3; ++e) {
+        const uint32_t a = m.indices[t + e], b = m.indices[t + (e + 1) % 3];
+        if ((m.positions[a] - m.positions[b]).squaredNorm() >= tol2) continue;
+        const uint32_t ra = root(a), rb = root(b);
+        if (ra == rb) continue;
+        parent[std::max(ra, rb)] = std::min(ra, rb);
+        any = true;
+      }
+    }
+    if (roots) {
+      roots->resize(n);
+      for (uint32_t i = 0; i < n; ++i) (*roots)[i] = root(i);
     }
   }
-  if (!any) return;
+  if (!any) return true;
   // Survivors that still have a triangle, renumbered in order.
   std::vector<uint32_t> tris;
   for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
@@ -514,6 +577,7 @@ void weldShortEdges(GarmentMesh& m, float tol) {
     out.pin_ring.push_back(m.pin_ring[k]);
   }
   m = std::move(out);
+  return true;
 }
 
 }  // namespace
@@ -538,7 +602,7 @@ const char* garmentKindName(GarmentKind kind) {
 }
 
 bool makeGarmentTemplate(const BodyModel& body, const GarmentTemplateParams& p, GarmentMesh& out,
-                         std::string& err) {
+                         std::string& err, TemplateLayout* record, const TemplateLayout* replay) {
   const int kind = static_cast<int>(p.kind);
   if (kind < 0 || kind > 4) {
     err = "garment template: unknown garment kind";
@@ -572,18 +636,41 @@ bool makeGarmentTemplate(const BodyModel& body, const GarmentTemplateParams& p, 
   proxies.build(body, restPose(body.shape()));
   Builder builder(body, p, proxies.ellipsoids(), proxies.sources());
 
-  // Resolution: spacing h adjusted until the particle count is within 4 % of the target.
-  const float target = static_cast<float>(p.target_particles);
-  float h = 0.03f;
   GarmentMesh mesh;
-  for (int it = 0; it < 12; ++it) {
-    builder.build(h, mesh);
-    const float n = static_cast<float>(mesh.positions.size());
-    if (std::fabs(n - target) <= 0.04f * target) break;
-    h *= std::clamp(std::sqrt(n / target), 0.7f, 1.4f);
+  TemplateLayout layout;
+  const bool replaying = replay != nullptr && !replay->empty();
+  if (replaying) {
+    // The first cut's choices, on this body.
+    builder.setLayout(nullptr, replay);
+    builder.build(replay->h, mesh);
+    builder.pushOut(mesh, EllipsoidCollider::kDefaultMargin + 0.002f);
+    std::vector<uint32_t> roots = replay->weld_root;
+    const bool fits = builder.replayed() && weldShortEdges(mesh, 0.0f, &roots, true) &&
+                      replay->pinned.size() == replay->pin_ring.size() &&
+                      std::all_of(replay->pinned.begin(), replay->pinned.end(),
+                                  [&](uint32_t v) { return v < mesh.positions.size(); });
+    if (!fits) {
+      err = "garment template: this body does not fit the recorded layout";
+      return false;
+    }
+    mesh.pinned = replay->pinned;
+    mesh.pin_ring = replay->pin_ring;
+  } else {
+    // Resolution: spacing h adjusted until the particle count is within 4 % of the target.
+    builder.setLayout(&layout, nullptr);
+    const float target = static_cast<float>(p.target_particles);
+    float h = 0.03f;
+    for (int it = 0; it < 12; ++it) {
+      builder.build(h, mesh);
+      const float n = static_cast<float>(mesh.positions.size());
+      if (std::fabs(n - target) <= 0.04f * target) break;
+      h *= std::clamp(std::sqrt(n / target), 0.7f, 1.4f);
+    }
+    builder.pushOut(mesh, EllipsoidCollider::kDefaultMargin + 0.002f);
+    weldShortEdges(mesh, 0.25f * h, &layout.weld_root);
+    layout.pinned = mesh.pinned;
+    layout.pin_ring = mesh.pin_ring;
   }
-  builder.pushOut(mesh, EllipsoidCollider::kDefaultMargin + 0.002f);
-  weldShortEdges(mesh, 0.25f * h);
   builder.finishPins(mesh);
   for (const Vec3& x : mesh.positions) {
     if (!x.allFinite()) {
@@ -592,6 +679,7 @@ bool makeGarmentTemplate(const BodyModel& body, const GarmentTemplateParams& p, 
     }
   }
   out = std::move(mesh);
+  if (record && !replaying) *record = std::move(layout);
   return true;
 }
 

@@ -32,10 +32,29 @@ struct GarmentMesh {
   std::vector<Vec3> pin_local;     // offset in that ring's frame: world = centre + frame * local
 };
 
-// body_in_rest_pose: a BodyModel updated with restPose(body.shape()) (the tracking ellipsoids of
-// that pose are what the template is pushed outside of).
+// The choices a template build makes from the body's proportions: the spacing, every ring and row
+// count, the rotations of the stitched loops, which short edges were welded, and the attachments.
+// Recorded on a garment's first build and replayed when it is cut again for another body (a shape
+// change, the skeleton's calibration: GarmentSim::refitted), so the new cut has the same
+// particles, triangles and attachments, placed as a template made for that body places them.
+struct TemplateLayout {
+  float h = 0.0f;
+  std::vector<int> counts;          // in the order the build asks for them
+  std::vector<int> rotations;       // stitchLoops rotations, in order
+  std::vector<uint32_t> weld_root;  // per vertex before welding: the vertex it was merged into
+  std::vector<uint32_t> pinned;     // after welding
+  std::vector<int> pin_ring;
+  bool empty() const { return counts.empty(); }
+};
+
+// body_in_rest_pose: a BodyModel updated with a rest pose (the tracking ellipsoids of that pose
+// are what the template is pushed outside of). `record` (optional) receives the build's layout;
+// `replay` (optional, from an earlier record of the same parameters) makes the same garment for
+// this body: it fails ("does not fit the recorded layout") should the body be so unlike the first
+// that the build goes another way.
 bool makeGarmentTemplate(const BodyModel& body_in_rest_pose, const GarmentTemplateParams& p,
-                         GarmentMesh& out, std::string& err);
+                         GarmentMesh& out, std::string& err, TemplateLayout* record = nullptr,
+                         const TemplateLayout* replay = nullptr);
 
 const char* garmentKindName(GarmentKind kind);
 

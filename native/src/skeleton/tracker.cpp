@@ -11,6 +11,7 @@ constexpr float kNominalDt = 1.0f / 30.0f;   // the Kinect frame period the Holt
 constexpr float kMinFilterDt = 1e-4f;        // smaller dt is treated as this inside the filters
 constexpr float kDegenerateM = 1e-4f;        // bones shorter than this have no usable direction
 constexpr float kMinLengthSampleM = 1e-3f;   // calibration ignores (near) zero-length samples
+constexpr float kCollapsedBoneFraction = 0.25f;  // calibrated: a shorter raw bone's far joint is not tracked
 constexpr int kMaxCalibSamples = 256;        // stored samples per bone and class
 constexpr int kMaxFrameCount = 1 << 20;      // saturating per-filter sample counter
 
@@ -267,7 +268,10 @@ void SkeletonTracker::collectCalibration(const SkeletonPose& raw) {
 
 void SkeletonTracker::updateLengths(const SkeletonPose& raw) {
   const bool windowDone = pushes_ >= p_.calibration_frames;  // pushes_ already counts this push
-  if (windowDone) calibrated_ = true;
+  if (windowDone && !calibrated_) {
+    calibrated_ = true;
+    ++calibrations_;
+  }
   const int lateTarget = std::max(1, std::min(p_.calibration_frames, calib_cap_));
   for (int b = 0; b < kBoneCount; ++b) {
     if (frozen_[b]) continue;
@@ -307,6 +311,17 @@ void SkeletonTracker::push(const SkeletonPose& raw, double time_s) {
 
   std::array<TrackingState, kJointCount> st;
   for (int j = 0; j < kJointCount; ++j) st[j] = sanitizeState(raw.state[j]);
+  // Once the bone lengths are calibrated, a reported bone shorter than a quarter of its length is
+  // no reading of a person (a sensor collapsing joints onto each other): its far joint counts as
+  // not tracked for this push, so it is held like a lost joint instead of folding the body.
+  if (calibrated_) {
+    for (int j = 1; j < kJointCount; ++j) {
+      const float l = len_[static_cast<size_t>(j - 1)];
+      if (st[j] != TrackingState::NotTracked && l > 0.0f &&
+          (raw.position[j] - raw.position[kJointParent[j]]).norm() < kCollapsedBoneFraction * l)
+        st[j] = TrackingState::NotTracked;
+    }
+  }
 
   // Teleport: the raw pelvis moved further than the person plausibly could since it was last seen.
   if (st[0] != TrackingState::NotTracked) {

@@ -63,6 +63,9 @@ class SkeletonTracker {
   const SkeletonPose& pose() const;  // filtered pose with held bone lengths; states as reported (after reconstruction: Inferred)
   bool hasPose() const;              // false until the first push
   bool calibrated() const;           // bone lengths frozen
+  // Calibrations completed since construction (reset() starts a new one; the count goes on), so a
+  // caller can tell a new set of frozen lengths from the one it has seen.
+  uint32_t calibrationCount() const { return calibrations_; }
   const std::array<float, kBoneCount>& boneLengths() const;  // current (calibrating: running estimate) lengths
   bool teleportedLastPush() const;
   // The last push's raw torso turned farther than a person can in its dt (filters restarted).
@@ -100,6 +103,7 @@ class SkeletonTracker {
   std::array<bool, kBoneCount> frozen_{};
   int pushes_ = 0;
   bool calibrated_ = false;
+  uint32_t calibrations_ = 0;
 
   std::array<JointFilter, kJointCount> filt_{};
   std::array<Vec3, kJointCount> est_{};       // filtered positions in raw space (lost: virtual)

@@ -1,0 +1,269 @@
+// Garments cut for the tracked person's skeleton (drape_context_desc.garment_fit, docs/garments.md
+// "Cut for the person's skeleton"): restPoseWithBones keeps the rest pose's limb directions with the
+// person's bone lengths and their torso's own geometry; once the tracker has calibrated, the context
+// refits every garment to that rest body (same particles and triangles, a new rest shape), unless
+// the person has the standard proportions; DRAPE_GARMENT_FIT_SHAPE never refits. Driven through
+// drape::Context with the tracker in the loop.
+#include "garment_scene.h"
+
+#include "body/body_shape.h"
+#include "cloth/garment_sim.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace drape {
+namespace {
+
+const ResolvedShape& standardShape() {
+  static const ResolvedShape s = resolveShape(BodyShapeInput{});
+  return s;
+}
+
+std::array<float, kBoneCount> boneLengthsOf(const SkeletonPose& p) {
+  std::array<float, kBoneCount> l{};
+  for (int b = 0; b < kBoneCount; ++b)
+    l[static_cast<size_t>(b)] = (p.position[static_cast<size_t>(boneChild(b))] - p.position[static_cast<size_t>(boneParent(b))]).norm();
+  return l;
+}
+
+float maxJointDistance(const SkeletonPose& a, const SkeletonPose& b) {
+  float d = 0.0f;
+  for (int j = 0; j < kJointCount; ++j) d = std::max(d, (a.position[static_cast<size_t>(j)] - b.position[static_cast<size_t>(j)]).norm());
+  return d;
+}
+
+// The standard rest pose with every bone below `from` (the subtree of that joint) scaled by `s`
+// about its parent joint: a person with longer or shorter limbs.
+void scaleSubtree(SkeletonPose& p, Joint from, float s) {
+  const int root = idx(from);
+  const Vec3 pivot = p.position[static_cast<size_t>(kJointParent[static_cast<size_t>(root)])];
+  for (int j = 0; j < kJointCount; ++j) {
+    int k = j;
+    while (k >= 0 && k != root) k = kJointParent[static_cast<size_t>(k)];
+    if (k == root) p.position[static_cast<size_t>(j)] = pivot + s * (p.position[static_cast<size_t>(j)] - pivot);
+  }
+}
+
+// A person unlike the standard one: legs 15 % shorter, spine 10 % longer, shoulders 4 cm higher
+// (a Kinect v2 on Ges01 measures legs ~16 % shorter and the torso ~9 % longer than the standard
+// proportions), arms hanging 75 degrees down.
+SkeletonPose otherPerson() {
+  SkeletonPose p = restPose(standardShape(), 75.0f);
+  for (Joint hip : {Joint::HipL, Joint::HipR}) {
+    const Vec3 h = p.position[static_cast<size_t>(idx(hip))];
+    SkeletonPose q = p;
+    scaleSubtree(q, hip == Joint::HipL ? Joint::KneeL : Joint::KneeR, 0.85f);
+    p = q;
+    p.position[static_cast<size_t>(idx(hip))] = h;
+  }
+  scaleSubtree(p, Joint::SpineMid, 1.1f);
+  for (Joint s : {Joint::ShoulderL, Joint::ShoulderR}) {
+    SkeletonPose q = p;
+    const Vec3 up(0.0f, 0.04f, 0.0f);
+    const int root = idx(s);
+    for (int j = 0; j < kJointCount; ++j) {
+      int k = j;
+      while (k >= 0 && k != root) k = kJointParent[static_cast<size_t>(k)];
+      if (k == root) q.position[static_cast<size_t>(j)] += up;
+    }
+    p = q;
+  }
+  return p;
+}
+
+TEST(RestPoseWithBones, TheStandardBonesGiveTheStandardPose) {
+  const SkeletonPose rest = restPose(standardShape(), 65.0f);
+  const SkeletonPose again = restPoseWithBones(standardShape(), 65.0f, boneLengthsOf(rest), &rest);
+  EXPECT_LT(maxJointDistance(rest, again), 1e-5f);
+  const SkeletonPose noTorso = restPoseWithBones(standardShape(), 65.0f, boneLengthsOf(rest));
+  EXPECT_LT(maxJointDistance(rest, noTorso), 1e-5f);
+}
+
+TEST(RestPoseWithBones, BonesTakeTheMeasuredLengthsAndKeepTheRestDirections) {
+  const SkeletonPose rest = restPose(standardShape(), 65.0f);
+  std::array<float, kBoneCount> l = boneLengthsOf(rest);
+  for (float& v : l) v *= 1.2f;
+  const int thigh = idx(Joint::KneeL) - 1;  // bone b ends at joint b + 1
+  l[static_cast<size_t>(thigh)] = 0.31f;
+  const SkeletonPose p = restPoseWithBones(standardShape(), 65.0f, l);
+  EXPECT_LT((p.position[0] - rest.position[0]).norm(), 1e-6f) << "the pelvis stays";
+  for (int b = 0; b < kBoneCount; ++b) {
+    const Vec3 d = p.position[static_cast<size_t>(boneChild(b))] - p.position[static_cast<size_t>(boneParent(b))];
+    const Vec3 r = rest.position[static_cast<size_t>(boneChild(b))] - rest.position[static_cast<size_t>(boneParent(b))];
+    EXPECT_NEAR(d.norm(), l[static_cast<size_t>(b)], 1e-4f) << "bone " << b;
+    EXPECT_GT(d.normalized().dot(r.normalized()), 0.99999f) << "bone " << b;
+  }
+}
+
+TEST(RestPoseWithBones, UnseenOrAbsurdLengthsAreHeld) {
+  const SkeletonPose rest = restPose(standardShape(), 65.0f);
+  const std::array<float, kBoneCount> standard = boneLengthsOf(rest);
+  std::array<float, kBoneCount> l = standard;
+  l[0] = 0.0f;                                        // never seen: the standard length
+  l[1] = std::numeric_limits<float>::quiet_NaN();    // the same
+  l[2] = std::numeric_limits<float>::infinity();     // the same
+  l[5] = 100.0f;                                      // at most 4x
+  l[6] = 0.011f;                                      // at least 0.25x
+  const std::array<float, kBoneCount> got = boneLengthsOf(restPoseWithBones(standardShape(), 65.0f, l));
+  EXPECT_NEAR(got[0], standard[0], 1e-5f);
+  EXPECT_NEAR(got[1], standard[1], 1e-5f);
+  EXPECT_NEAR(got[2], standard[2], 1e-5f);
+  EXPECT_NEAR(got[5], 4.0f * standard[5], 1e-4f);
+  EXPECT_NEAR(got[6], 0.25f * standard[6], 1e-5f);
+  for (int b = 7; b < kBoneCount; ++b) EXPECT_NEAR(got[static_cast<size_t>(b)], standard[static_cast<size_t>(b)], 1e-5f);
+}
+
+TEST(RestPoseWithBones, TheTorsoGeometryComesFromThePersonWhereverTheyStand) {
+  // The other person, turned 90 degrees and 2 m to the side, leaning 10 degrees: the rest pose
+  // takes their torso in the frame of their pelvis (spine up, hips across), so it does not depend on
+  // where they stand or which way they face; the lean is part of that geometry.
+  const SkeletonPose person = otherPerson();
+  SkeletonPose moved = person;
+  const Mat3 R = Eigen::AngleAxisf(0.5f * kPi, Vec3::UnitY()).toRotationMatrix();
+  for (Vec3& x : moved.position) x = R * (x - person.position[0]) + Vec3(2.0f, 0.0f, 1.0f) + person.position[0];
+  const std::array<float, kBoneCount> l = boneLengthsOf(person);
+  const SkeletonPose a = restPoseWithBones(standardShape(), 65.0f, l, &person);
+  const SkeletonPose b = restPoseWithBones(standardShape(), 65.0f, l, &moved);
+  EXPECT_LT(maxJointDistance(a, b), 1e-4f);
+  // The raised shoulders are in it: 4 cm above the standard pose's, relative to the spine.
+  for (Joint s : {Joint::ShoulderL, Joint::ShoulderR}) {
+    const float h = a.position[static_cast<size_t>(idx(s))].y() - a.position[static_cast<size_t>(idx(Joint::SpineShoulder))].y();
+    const SkeletonPose rest = restPose(standardShape(), 65.0f);
+    const float h0 = rest.position[static_cast<size_t>(idx(s))].y() - rest.position[static_cast<size_t>(idx(Joint::SpineShoulder))].y();
+    EXPECT_NEAR(h - h0, 0.04f, 0.005f);
+  }
+  // A degenerate torso (every joint at one point) is ignored: the rest directions stay.
+  SkeletonPose flat = person;
+  for (Vec3& x : flat.position) x = Vec3(0.0f, 1.0f, 2.0f);
+  const SkeletonPose c = restPoseWithBones(standardShape(), 65.0f, l, &flat);
+  EXPECT_LT(maxJointDistance(c, restPoseWithBones(standardShape(), 65.0f, l)), 1e-6f);
+}
+
+// A context with one garment on a person standing in `pose`, swaying 3 cm sideways.
+struct Person {
+  std::unique_ptr<Context> ctx;
+  GarmentSim* garment = nullptr;
+  SkeletonPose pose;
+  double t = 0.0;
+
+  Person(const SkeletonPose& p, GarmentKind kind, int32_t fit) : pose(p) {
+    drape_context_desc d = test::defaultDesc();
+    d.garment_fit = fit;
+    ctx = std::make_unique<Context>(d);
+    std::string err;
+    garment = test::addTemplate(*ctx, kind, 800, ClothSolverKind::Xpbd, GarmentSimParams{}, err);
+    EXPECT_NE(garment, nullptr) << err;
+  }
+  void step() {
+    SkeletonPose now = pose;
+    const float x = 0.03f * static_cast<float>(std::sin(2.0 * t));
+    for (Vec3& j : now.position) j += Vec3(x, 0.0f, 0.0f);
+    Recording rec;
+    rec.layout = Layout::Kinect2;
+    t += 1.0 / 30.0;
+    std::string err;
+    ASSERT_EQ(test::pushAndStep(*ctx, rec, test::kinect2FromPose(now, t), t, 1.0f / 30.0f, err), DRAPE_OK) << err;
+  }
+  // Median per-frame P99 stretch over `frames` frames; inside: particles inside an ellipsoid, summed.
+  float medianP99(int frames, uint64_t* inside) {
+    std::vector<float> p99;
+    for (int f = 0; f < frames; ++f) {
+      step();
+      const GarmentAccuracy a = ctx->measureGarment(*garment);
+      p99.push_back(a.stretch.p99);
+      *inside += a.proxy_inside;
+    }
+    std::sort(p99.begin(), p99.end());
+    return p99[p99.size() / 2];
+  }
+};
+
+TEST(GarmentFit, CalibrationRecutsTheGarmentsForThePersonsBones) {
+  for (GarmentKind kind : {GarmentKind::Trousers, GarmentKind::TShirt}) {
+    Person fitted(otherPerson(), kind, DRAPE_GARMENT_FIT_SKELETON);
+    Person standard(otherPerson(), kind, DRAPE_GARMENT_FIT_SHAPE);
+    ASSERT_NE(fitted.garment, nullptr);
+    ASSERT_NE(standard.garment, nullptr);
+    const size_t particles = fitted.garment->particleCount();
+    const std::vector<uint32_t> triangles = fitted.garment->indices();
+    const DistanceConstraints cut = fitted.garment->topology().stretch;
+    for (int f = 0; f < 29; ++f) {
+      fitted.step();
+      standard.step();
+    }
+    EXPECT_EQ(fitted.garment->refits(), 0u) << "not calibrated yet";
+    fitted.step();  // the 30th push calibrates
+    standard.step();
+    EXPECT_EQ(fitted.garment->refits(), 1u);
+    EXPECT_EQ(standard.garment->refits(), 0u);
+    EXPECT_EQ(&fitted.ctx->garment(0), fitted.garment) << "the same garment object (the C ABI handle)";
+    EXPECT_EQ(fitted.garment->particleCount(), particles);
+    EXPECT_EQ(fitted.garment->indices(), triangles);
+    double before = 0.0, after = 0.0;
+    for (float r : cut.rest) before += r;
+    for (float r : fitted.garment->topology().stretch.rest) after += r;
+    EXPECT_GT(std::fabs(after / before - 1.0), 0.005) << "a new cut";
+    // The rest body's ellipsoids come in the frames' count and order (collision groups by index).
+    const std::vector<int>& chains = fitted.ctx->restEllipsoidChains();
+    const std::vector<ProxySource>& sources = fitted.ctx->proxies().sources();
+    ASSERT_EQ(chains.size(), sources.size());
+    for (size_t k = 0; k < chains.size(); ++k) ASSERT_EQ(chains[k], static_cast<int>(sources[k].chain)) << k;
+
+    uint64_t insideFitted = 0, insideStandard = 0;
+    const float a = fitted.medianP99(40, &insideFitted);
+    const float b = standard.medianP99(40, &insideStandard);
+    std::printf("[ figures  ] %s: median P99 stretch cut for the skeleton %.3f, for the shape %.3f; inside %llu / %llu\n",
+                garmentKindName(kind), a, b, static_cast<unsigned long long>(insideFitted),
+                static_cast<unsigned long long>(insideStandard));
+    EXPECT_EQ(insideFitted, 0u);
+    EXPECT_LT(a, b) << garmentKindName(kind);
+    EXPECT_EQ(fitted.garment->refits(), 1u) << "once per calibration";
+    for (size_t i = 0; i < particles; ++i) ASSERT_TRUE(fitted.garment->positions()[i].allFinite());
+  }
+}
+
+TEST(GarmentFit, TheStandardProportionsKeepTheGarmentAsItIs) {
+  // A person with the shape's own proportions (the garments' rest pose, arms as they like): the
+  // calibration finds nothing to refit, so the garment steps exactly as with FIT_SHAPE.
+  Person a(restPose(standardShape(), 70.0f), GarmentKind::TShirt, DRAPE_GARMENT_FIT_SKELETON);
+  Person b(restPose(standardShape(), 70.0f), GarmentKind::TShirt, DRAPE_GARMENT_FIT_SHAPE);
+  for (int f = 0; f < 40; ++f) {
+    a.step();
+    b.step();
+  }
+  EXPECT_EQ(a.garment->refits(), 0u);
+  for (size_t i = 0; i < a.garment->particleCount(); ++i)
+    ASSERT_EQ(a.garment->positions()[i], b.garment->positions()[i]) << "particle " << i;
+}
+
+TEST(GarmentFit, AGarmentAddedAfterCalibrationIsCutForThePersonAtOnce) {
+  Person early(otherPerson(), GarmentKind::Trousers, DRAPE_GARMENT_FIT_SKELETON);
+  for (int f = 0; f < 35; ++f) early.step();
+  ASSERT_EQ(early.garment->refits(), 1u);
+  std::string err;
+  GarmentSim* late = test::addTemplate(*early.ctx, GarmentKind::Trousers, 800, ClothSolverKind::Xpbd, GarmentSimParams{}, err);
+  ASSERT_NE(late, nullptr) << err;
+  uint64_t inside = 0;
+  early.medianP99(10, &inside);
+  EXPECT_EQ(late->refits(), 0u) << "made on the person's rest body: nothing to refit";
+  EXPECT_EQ(early.garment->refits(), 1u);
+  EXPECT_EQ(inside, 0u);
+}
+
+TEST(GarmentFit, OneRefitPerCalibration) {
+  // The check runs at every step; a calibration is acted on once (80 frames, one refit).
+  Person p(otherPerson(), GarmentKind::Skirt, DRAPE_GARMENT_FIT_SKELETON);
+  for (int f = 0; f < 80; ++f) p.step();
+  EXPECT_EQ(p.garment->refits(), 1u);
+}
+
+}  // namespace
+}  // namespace drape
