@@ -64,6 +64,7 @@ namespace Drape.Tests
             Assert.Equal(30u, d.CalibrationFrames);
             Assert.Equal(Filter.OneEuro, d.Filter);
             Assert.Equal(ProxyRule.Drape, d.ProxyRule);
+            Assert.Equal(GarmentFit.Skeleton, d.GarmentFit);
             using var standard = new Context(d);
             d.RingPoints = 32;
             using var finer = new Context(d);
@@ -78,6 +79,14 @@ namespace Drape.Tests
             var e = Assert.Throws<DrapeException>(() => new Context(d));
             Assert.Equal(ResultCode.OutOfRange, e.Code);
             Assert.Contains("ring_points", e.NativeMessage);
+
+            d = ContextDesc.CreateDefault();
+            d.GarmentFit = (GarmentFit)2;
+            e = Assert.Throws<DrapeException>(() => new Context(d));
+            Assert.Equal(ResultCode.OutOfRange, e.Code);
+            Assert.Contains("garment_fit", e.NativeMessage);
+            d.GarmentFit = GarmentFit.Shape;
+            using (new Context(d)) { }
 
             e = Assert.Throws<DrapeException>(() => new Context(default(ContextDesc)));  // struct_size 0
             Assert.Equal(ResultCode.InvalidArgument, e.Code);

@@ -224,6 +224,9 @@ namespace Drape.Tests
             Assert.Equal(20ul, g.Stats.Steps);
             GarmentAccuracy a = g.Measure();
             Assert.True(a.P99Stretch < 0.5f, $"p99 stretch {a.P99Stretch}");
+            Assert.Equal(1u, g.Stats.Refits);  // 20 frames: not calibrated yet (30), one refit for the shape
+            StepFrames(ctx, 15, 20);
+            Assert.Equal(2u, g.Stats.Refits);  // cut again for the calibrated skeleton (GarmentFit.Skeleton)
 
             // The same shape again changes nothing.
             var before = new Vector3f[vertices];
