@@ -122,7 +122,7 @@ drape_result Context::setShape(const BodyShapeInput& in, std::string& err) {
   // Garments are refitted to the new body (GarmentSim::refitted, docs/garments.md "Body shape
   // changes"): all of them or, when one cannot be dressed on it, none and the old shape back.
   // The same measurements again (a host that sets the shape every frame) change nothing.
-  if (before.m != shape_.m && !refitGarments(err)) {
+  if (before.m != shape_.m && !refitGarments(err, /*remake_templates=*/false)) {
     useShape(before);
     err += "; the previous shape is kept";
     return DRAPE_ERROR_INVALID_ARGUMENT;
@@ -162,7 +162,7 @@ void Context::fitGarmentsToSkeleton() {
   fittedTorso_ = torso;
   restBody_.reset();
   std::string err;
-  if (!refitGarments(err)) {
+  if (!refitGarments(err, /*remake_templates=*/true)) {
     fitBones_ = before;
     fittedBones_ = beforeBones;
     fittedTorso_ = beforeTorso;
@@ -173,12 +173,12 @@ void Context::fitGarmentsToSkeleton() {
   proxyBounds_.clear();
 }
 
-bool Context::refitGarments(std::string& err) {
+bool Context::refitGarments(std::string& err, bool remake_templates) {
   std::vector<std::unique_ptr<GarmentSim>> refits;
   refits.reserve(garments_.size());
   for (size_t i = 0; i < garments_.size(); ++i) {
     std::string why;
-    refits.push_back(garments_[i]->refitted(restBody(), restEllipsoids(), restEllipsoidChains(), why));
+    refits.push_back(garments_[i]->refitted(restBody(), restEllipsoids(), restEllipsoidChains(), why, remake_templates));
     if (!refits.back()) {
       err = "garment " + std::to_string(i) + " could not be dressed on the new body (" + why + ")";
       return false;

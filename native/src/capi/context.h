@@ -108,7 +108,7 @@ class Context {
   void fitGarmentsToSkeleton();
   // Refits every garment to restBody() (after a shape change or the tracker's calibration): all
   // of them or, when one cannot be dressed on the new body, none (err says which and why).
-  bool refitGarments(std::string& err);
+  bool refitGarments(std::string& err, bool remake_templates);
   ProxyBuilder restProxies_;
   std::vector<int> restChains_;
   std::vector<std::unique_ptr<GarmentSim>> garments_;

@@ -301,17 +301,18 @@ std::unique_ptr<GarmentSim> GarmentSim::createTemplate(const GarmentTemplatePara
 std::unique_ptr<GarmentSim> GarmentSim::refitted(const BodyModel& body_rest,
                                                  const std::vector<Ellipsoid>& rest_ellipsoids,
                                                  const std::vector<int>& ellipsoid_chains,
-                                                 std::string& err) const {
+                                                 std::string& err, bool remake_template) const {
   const Origin& o = *origin_;
   if (o.rest_rings.size() != body_rest.rings().size()) {
     err = "the new body has another ring layout than the one the garment was made on";
     return nullptr;
   }
-  if (o.from_template) {
+  if (o.from_template && remake_template) {
     // The template made again for this body with the first cut's layout: the particles, triangles
-    // and attachments of the garment, placed as a template made for this body places them (a
-    // better cut than carrying the old one by ring skinning: docs/garments.md). Should the body
-    // be too unlike the first for the layout, the ring skinning below does it.
+    // and attachments of the garment, placed as a template made for this body places them (for a
+    // person's own proportions a better cut than carrying the old one by ring skinning:
+    // docs/garments.md). Should the body be too unlike the first for the layout, the ring
+    // skinning below does it.
     GarmentMesh mesh;
     std::string why;
     if (makeGarmentTemplate(body_rest, o.tmpl, mesh, why, nullptr, &o.layout) && mesh.indices == o.mesh.indices &&

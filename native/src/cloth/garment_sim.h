@@ -121,8 +121,13 @@ class GarmentSim {
   // and parameters; it sits on the new rest pose until its first step places it on the tracked
   // body (as a new garment does). Null + err when the dressing fails. docs/garments.md, "Body
   // shape changes".
+  // remake_template: a template garment is made again on body_rest with its first build's layout
+  // (TemplateLayout) instead of being carried by skinning (the skeleton's calibration:
+  // docs/garments.md, "Cut for the person's skeleton"; a shape change carries it, which measured
+  // closer to a garment made for the new body there).
   std::unique_ptr<GarmentSim> refitted(const BodyModel& body_rest, const std::vector<Ellipsoid>& rest_ellipsoids,
-                                       const std::vector<int>& ellipsoid_chains, std::string& err) const;
+                                       const std::vector<int>& ellipsoid_chains, std::string& err,
+                                       bool remake_template = false) const;
   // Takes over `fresh` (from refitted()) and keeps what identifies this garment to its owner: the
   // C ABI token and owner, its step count and glitch counters; counts the refit.
   void replaceWith(GarmentSim&& fresh);
