@@ -5,6 +5,7 @@
 // the person has the standard proportions; DRAPE_GARMENT_FIT_SHAPE never refits. Driven through
 // drape::Context with the tracker in the loop.
 #include "garment_scene.h"
+#include "test_data.h"
 
 #include "body/body_shape.h"
 #include "cloth/garment_sim.h"
@@ -256,6 +257,50 @@ TEST(GarmentFit, AGarmentAddedAfterCalibrationIsCutForThePersonAtOnce) {
   EXPECT_EQ(late->refits(), 0u) << "made on the person's rest body: nothing to refit";
   EXPECT_EQ(early.garment->refits(), 1u);
   EXPECT_EQ(inside, 0u);
+}
+
+// Ges01's calibrated skeleton (the bundled Kinect take): the T-shirt made again there with the
+// layout recorded on the standard body has the same vertices, triangles and attachments, and no
+// collapsed edge (one of its seam edges came out 20 um long before separateShortEdges).
+TEST(GarmentFit, ARemadeTemplateKeepsItsTopologyAndHasNoCollapsedEdge) {
+  DRAPE_REQUIRE_SHARED(path, "kinect_v2_msft_labanotation/Ges01_wavehand.csv");
+  Recording rec;
+  std::string err;
+  ASSERT_TRUE(readRecordingFile(path, 0, rec, err)) << err;
+  Context standard(test::defaultDesc()), person(test::defaultDesc());
+  GarmentTemplateParams tp;
+  tp.kind = GarmentKind::TShirt;
+  GarmentMesh first, again;
+  TemplateLayout layout;
+  ASSERT_TRUE(makeGarmentTemplate(standard.restBody(), tp, first, err, &layout)) << err;
+  ASSERT_FALSE(layout.empty());
+  double prev = rec.frames[0].time_s - 1.0 / 30.0;
+  for (int i = 0; i < 31; ++i) {
+    const RecordingFrame& f = rec.frames[static_cast<size_t>(i)];
+    ASSERT_EQ(test::pushAndStep(person, rec, f, f.time_s, static_cast<float>(f.time_s - prev), err), DRAPE_OK) << err;
+    prev = f.time_s;
+  }
+  ASSERT_TRUE(person.tracker().calibrated());
+  ASSERT_TRUE(makeGarmentTemplate(person.restBody(), tp, again, err, nullptr, &layout)) << err;
+  EXPECT_EQ(again.positions.size(), first.positions.size());
+  EXPECT_EQ(again.indices, first.indices);
+  EXPECT_EQ(again.pinned, first.pinned);
+  EXPECT_EQ(again.pin_ring, first.pin_ring);
+  float shortest = std::numeric_limits<float>::max(), moved = 0.0f;
+  for (size_t t = 0; t + 2 < again.indices.size(); t += 3)
+    for (size_t e = 0; e < 3; ++e)
+      shortest = std::min(shortest, (again.positions[again.indices[t + e]] - again.positions[again.indices[t + (e + 1) % 3]]).norm());
+  for (size_t i = 0; i < again.positions.size(); ++i) moved = std::max(moved, (again.positions[i] - first.positions[i]).norm());
+  std::printf("[ figures  ] shortest edge %.4f m (spacing %.4f m); the cut moved up to %.3f m\n", shortest, layout.h, moved);
+  EXPECT_GE(shortest, 0.24f * layout.h);
+  EXPECT_GT(moved, 0.02f) << "another body: another cut";
+  // A layout from another garment kind does not fit: refused, nothing written.
+  GarmentTemplateParams skirt;
+  skirt.kind = GarmentKind::Skirt;
+  GarmentMesh untouched;
+  EXPECT_FALSE(makeGarmentTemplate(person.restBody(), skirt, untouched, err, nullptr, &layout));
+  EXPECT_NE(err.find("layout"), std::string::npos) << err;
+  EXPECT_TRUE(untouched.positions.empty());
 }
 
 TEST(GarmentFit, OneRefitPerCalibration) {

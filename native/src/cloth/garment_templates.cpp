@@ -580,6 +580,35 @@ bool weldShortEdges(GarmentMesh& m, float tol, std::vector<uint32_t>* roots = nu
   return true;
 }
 
+// A template made again with a recorded layout keeps its triangles, so a seam vertex that lands on
+// a neighbour on the new body cannot be welded as the first build would: such an edge (20 um on
+// Ges01's calibrated skeleton) would be a needle-stiff constraint and a stretch ratio of thousands.
+// Its ends are moved apart, along the edge, to `min_len` (a few passes: moving one edge can shorten
+// another; those left are rarer still).
+void separateShortEdges(GarmentMesh& m, float min_len) {
+  for (int pass = 0; pass < 4; ++pass) {
+    bool moved = false;
+    for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
+      for (size_t e = 0; e < 3; ++e) {
+        Vec3& a = m.positions[m.indices[t + e]];
+        Vec3& b = m.positions[m.indices[t + (e + 1) % 3]];
+        const Vec3 d = b - a;
+        const float len = d.norm();
+        if (len >= min_len) continue;
+        // Along the edge, or (coincident ends) along the triangle's third vertex's direction.
+        Vec3 dir = len > 1e-7f ? Vec3(d / len) : Vec3(m.positions[m.indices[t + (e + 2) % 3]] - a);
+        if (!(dir.norm() > 1e-7f)) dir = Vec3::UnitX();
+        dir.normalize();
+        const Vec3 mid = 0.5f * (a + b);
+        a = mid - 0.5f * min_len * dir;
+        b = mid + 0.5f * min_len * dir;
+        moved = true;
+      }
+    }
+    if (!moved) return;
+  }
+}
+
 }  // namespace
 
 void pinOffsetsFromPositions(const BodyModel& body, GarmentMesh& m) {
@@ -655,6 +684,7 @@ bool makeGarmentTemplate(const BodyModel& body, const GarmentTemplateParams& p, 
     }
     mesh.pinned = replay->pinned;
     mesh.pin_ring = replay->pin_ring;
+    separateShortEdges(mesh, 0.25f * replay->h);
   } else {
     // Resolution: spacing h adjusted until the particle count is within 4 % of the target.
     builder.setLayout(&layout, nullptr);
