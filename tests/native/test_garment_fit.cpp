@@ -148,6 +148,35 @@ TEST(RestPoseWithBones, TheTorsoGeometryComesFromThePersonWhereverTheyStand) {
   EXPECT_LT(maxJointDistance(c, restPoseWithBones(standardShape(), 65.0f, l)), 1e-6f);
 }
 
+TEST(TorsoAverage, AveragesTheTorsoInThePelvisFrameAndSkipsCollapsedOnes) {
+  const SkeletonPose person = otherPerson();
+  const std::array<float, kBoneCount> l = boneLengthsOf(person);
+  TorsoAverage avg;
+  EXPECT_TRUE(avg.empty());
+  SkeletonPose collapsed = person;
+  for (Vec3& x : collapsed.position) x = Vec3(0.0f, 1.0f, 2.0f);
+  avg.add(collapsed);
+  EXPECT_TRUE(avg.empty()) << "no pelvis frame: skipped";
+  // The person turned and moved about, and leaning 10 degrees either way: the average is upright.
+  for (int k = 0; k < 6; ++k) {
+    SkeletonPose q = person;
+    const Mat3 turn = Eigen::AngleAxisf(0.4f * static_cast<float>(k), Vec3::UnitY()).toRotationMatrix();
+    for (Vec3& x : q.position) x = turn * (x - person.position[0]) + Vec3(0.3f * static_cast<float>(k), 0.0f, 0.1f) + person.position[0];
+    const Mat3 lean = Eigen::AngleAxisf((k % 2 ? 1.0f : -1.0f) * 10.0f * kPi / 180.0f, turn * Vec3::UnitZ()).toRotationMatrix();
+    for (int j : {idx(Joint::SpineShoulder), idx(Joint::Neck), idx(Joint::Head), idx(Joint::ShoulderL), idx(Joint::ShoulderR)})
+      q.position[static_cast<size_t>(j)] = lean * (q.position[static_cast<size_t>(j)] - q.position[static_cast<size_t>(idx(Joint::SpineMid))]) +
+                                           q.position[static_cast<size_t>(idx(Joint::SpineMid))];
+    avg.add(q);
+  }
+  ASSERT_FALSE(avg.empty());
+  const SkeletonPose mean = avg.mean();
+  const SkeletonPose fromMean = restPoseWithBones(standardShape(), 65.0f, l, &mean);
+  const SkeletonPose fromPerson = restPoseWithBones(standardShape(), 65.0f, l, &person);
+  EXPECT_LT(maxJointDistance(fromMean, fromPerson), 0.005f);
+  avg.clear();
+  EXPECT_TRUE(avg.empty());
+}
+
 // A context with one garment on a person standing in `pose`, swaying 3 cm sideways.
 struct Person {
   std::unique_ptr<Context> ctx;

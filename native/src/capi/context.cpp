@@ -26,7 +26,7 @@ constexpr float kGarmentRestArmDownDeg = 65.0f;
 
 // A person whose rest pose (their bones, their torso) is within this of the one the garments were
 // cut on keeps the garments as they are at calibration: a refit re-dresses every garment (a visible
-// change, and ~10-20 ms at 2 000 particles) for a difference the cloth absorbs anyway.
+// change, and 29 ms at 1 802 particles, docs/garments.md) for a difference the cloth absorbs anyway.
 constexpr float kRefitBelowM = 0.01f;
 
 // Coordinates beyond this are not a person in front of a sensor; rejecting them keeps 1e30-style
@@ -167,7 +167,6 @@ void Context::fitGarmentsToSkeleton() {
     fittedBones_ = beforeBones;
     fittedTorso_ = beforeTorso;
     restBody_.reset();
-    ++boneFitFailures_;
   }
   wakeAll();
   proxyBounds_.clear();

@@ -103,7 +103,6 @@ class Context {
   TorsoAverage torsoAverage_;  // the torso over the calibration window
   SkeletonPose restPoseUsed_{};
   uint32_t fittedCalibration_ = 0;  // the tracker's calibrationCount() last seen
-  uint32_t boneFitFailures_ = 0;    // calibrations whose refit failed (garments kept as they were)
   SkeletonPose garmentRestPose() const;
   void fitGarmentsToSkeleton();
   // Refits every garment to restBody() (after a shape change or the tracker's calibration): all
