@@ -12,6 +12,7 @@ constexpr float kMinFilterDt = 1e-4f;        // smaller dt is treated as this in
 constexpr float kDegenerateM = 1e-4f;        // bones shorter than this have no usable direction
 constexpr float kMinLengthSampleM = 1e-3f;   // calibration ignores (near) zero-length samples
 constexpr float kCollapsedBoneFraction = 0.25f;  // calibrated: a shorter raw bone's far joint is not tracked
+constexpr int kCollapsedBonePushes = 2;          // ... from the second push in a row that reads it so
 constexpr int kMaxCalibSamples = 256;        // stored samples per bone and class
 constexpr int kMaxFrameCount = 1 << 20;      // saturating per-filter sample counter
 
@@ -85,6 +86,7 @@ void SkeletonTracker::reset() {
   dir_.fill(Vec3::UnitY());
   len_.fill(0.0f);
   lost_.fill(false);
+  collapsed_run_.fill(0);
   lost_since_.fill(0.0);
   blend_end_.fill(-std::numeric_limits<double>::infinity());
   pose_ = SkeletonPose{};
@@ -313,14 +315,18 @@ void SkeletonTracker::push(const SkeletonPose& raw, double time_s) {
   for (int j = 0; j < kJointCount; ++j) st[j] = sanitizeState(raw.state[j]);
   // Once the bone lengths are calibrated, a reported bone shorter than a quarter of its length is
   // no reading of a person (a sensor collapsing joints onto each other): its far joint counts as
-  // not tracked for this push, so it is held like a lost joint instead of folding the body.
-  if (calibrated_) {
-    for (int j = 1; j < kJointCount; ++j) {
-      const float l = len_[static_cast<size_t>(j - 1)];
-      if (st[j] != TrackingState::NotTracked && l > 0.0f &&
-          (raw.position[j] - raw.position[kJointParent[j]]).norm() < kCollapsedBoneFraction * l)
-        st[j] = TrackingState::NotTracked;
-    }
+  // not tracked, held like a lost joint instead of folding the body. From the second push in a row:
+  // 2 cm of jitter shortens a 5-9 cm bone (hand, neck, hip) that much on a frame now and then, and
+  // a joint coming back restarts its filter unsmoothed (StressJitter under the sanitizers failed
+  // when it acted at once). Holding only the long bones at once, or a collapsed joint at its last
+  // estimate for one push, both failed StressBones (a half-held or a re-folded skeleton).
+  for (int j = 1; j < kJointCount; ++j) {
+    const float l = len_[static_cast<size_t>(j - 1)];
+    const bool collapsed = calibrated_ && st[j] != TrackingState::NotTracked && l > 0.0f &&
+                           (raw.position[j] - raw.position[kJointParent[j]]).norm() < kCollapsedBoneFraction * l;
+    int& run = collapsed_run_[static_cast<size_t>(j)];
+    run = collapsed ? run + 1 : 0;
+    if (run >= kCollapsedBonePushes) st[j] = TrackingState::NotTracked;
   }
 
   // Teleport: the raw pelvis moved further than the person plausibly could since it was last seen.

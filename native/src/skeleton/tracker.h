@@ -110,6 +110,7 @@ class SkeletonTracker {
   std::array<Vec3, kBoneCount> dir_{};        // output bone directions (unit)
   std::array<float, kBoneCount> len_{};
   std::array<bool, kJointCount> lost_{};
+  std::array<int, kJointCount> collapsed_run_{};  // pushes in a row with the joint's bone collapsed
   std::array<double, kJointCount> lost_since_{};
   std::array<double, kJointCount> blend_end_{};  // recovery blend ends at this time (<= now: none)
   Vec3 root_held_ = Vec3::Zero();
