@@ -16,7 +16,7 @@ struct Options {
   uint32_t max_frames = 0;         // 0: every frame of the recording
   uint32_t ring_points = 0;        // 0: the library default
   int32_t proxy_rule = DRAPE_PROXY_RULE_DRAPE;
-  int32_t garment_fit = DRAPE_GARMENT_FIT_SKELETON;
+  int32_t garment_fit = DRAPE_GARMENT_FIT_SHAPE;
   uint32_t fidelity_every = 10;    // measure proxy fidelity every N updated frames; 0: never
 
   // The garment (--garment). kind is a drape_garment_kind for a template; garment_none turns the

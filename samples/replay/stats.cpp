@@ -188,7 +188,7 @@ std::string statsJson(const ReplayStats& s) {
   w.key("triangles").value(s.garment_triangles);
   w.key("edges").value(static_cast<int64_t>(s.stretch.edgeCount()));
   w.key("attached").value(s.attached);
-  w.key("fit").value(s.garment_fit == DRAPE_GARMENT_FIT_SHAPE ? "shape" : "skeleton");
+  w.key("fit").value(s.garment_fit == DRAPE_GARMENT_FIT_SKELETON ? "skeleton" : "shape");
   w.key("refits").value(s.refits);
   w.key("frames_stepped").value(static_cast<uint32_t>(s.cloth_ms.size()));
   w.key("max_stretch").value(s.stretch.max());
@@ -262,9 +262,9 @@ std::string summaryText(const ReplayStats& s, const std::string& obj_dir, const 
         s.solver == DRAPE_SOLVER_MASS_SPRING ? "massspring" : "xpbd", s.substep_hz, passes.c_str(), s.particles,
         s.attached, s.garment_triangles);
     appendf(o, "fit         %s%s\n",
-            s.garment_fit == DRAPE_GARMENT_FIT_SHAPE ? "the body shape's standard proportions (--garment-fit shape)"
-                                                     : "the person's skeleton once calibrated",
-            s.garment_fit == DRAPE_GARMENT_FIT_SHAPE ? ""
+            s.garment_fit != DRAPE_GARMENT_FIT_SKELETON ? "the body shape's standard proportions"
+                                                        : "the person's skeleton once calibrated (--garment-fit skeleton)",
+            s.garment_fit != DRAPE_GARMENT_FIT_SKELETON ? ""
             : s.refits > 0 ? (", cut again " + std::to_string(s.refits) + "x").c_str()
                            : ", no refit (proportions within 1 cm of the standard ones, or not calibrated)");
     appendf(o, "backend     %s%s%s%s\n", s.backend.c_str(), s.device.empty() ? "" : (" on " + s.device).c_str(),

@@ -567,7 +567,7 @@ TEST(Capi, DescInitFillsDocumentedDefaults) {
   EXPECT_EQ(d.calibration_frames, 30u);
   EXPECT_EQ(d.filter, DRAPE_FILTER_ONE_EURO);
   EXPECT_EQ(d.proxy_rule, DRAPE_PROXY_RULE_DRAPE);
-  EXPECT_EQ(d.garment_fit, DRAPE_GARMENT_FIT_SKELETON);
+  EXPECT_EQ(d.garment_fit, DRAPE_GARMENT_FIT_SHAPE);
   EXPECT_FLOAT_EQ(d.teleport_distance_m, 0.5f);
   EXPECT_GT(d.filter_min_cutoff_hz, 0.0f);
   EXPECT_GE(d.filter_beta, 0.0f);

@@ -296,7 +296,9 @@ TEST(GarmentFit, ARemadeTemplateKeepsItsTopologyAndHasNoCollapsedEdge) {
   Recording rec;
   std::string err;
   ASSERT_TRUE(readRecordingFile(path, 0, rec, err)) << err;
-  Context standard(test::defaultDesc()), person(test::defaultDesc());
+  drape_context_desc fit = test::defaultDesc();
+  fit.garment_fit = DRAPE_GARMENT_FIT_SKELETON;
+  Context standard(test::defaultDesc()), person(fit);
   GarmentTemplateParams tp;
   tp.kind = GarmentKind::TShirt;
   GarmentMesh first, again;

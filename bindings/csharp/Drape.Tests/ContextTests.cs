@@ -64,7 +64,7 @@ namespace Drape.Tests
             Assert.Equal(30u, d.CalibrationFrames);
             Assert.Equal(Filter.OneEuro, d.Filter);
             Assert.Equal(ProxyRule.Drape, d.ProxyRule);
-            Assert.Equal(GarmentFit.Skeleton, d.GarmentFit);
+            Assert.Equal(GarmentFit.Shape, d.GarmentFit);
             using var standard = new Context(d);
             d.RingPoints = 32;
             using var finer = new Context(d);
@@ -85,7 +85,7 @@ namespace Drape.Tests
             e = Assert.Throws<DrapeException>(() => new Context(d));
             Assert.Equal(ResultCode.OutOfRange, e.Code);
             Assert.Contains("garment_fit", e.NativeMessage);
-            d.GarmentFit = GarmentFit.Shape;
+            d.GarmentFit = GarmentFit.Skeleton;
             using (new Context(d)) { }
 
             e = Assert.Throws<DrapeException>(() => new Context(default(ContextDesc)));  // struct_size 0

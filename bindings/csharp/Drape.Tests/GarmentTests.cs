@@ -224,9 +224,22 @@ namespace Drape.Tests
             Assert.Equal(20ul, g.Stats.Steps);
             GarmentAccuracy a = g.Measure();
             Assert.True(a.P99Stretch < 0.5f, $"p99 stretch {a.P99Stretch}");
-            Assert.Equal(1u, g.Stats.Refits);  // 20 frames: not calibrated yet (30), one refit for the shape
+            Assert.Equal(1u, g.Stats.Refits);  // one refit, for the shape
             StepFrames(ctx, 15, 20);
-            Assert.Equal(2u, g.Stats.Refits);  // cut again for the calibrated skeleton (GarmentFit.Skeleton)
+            Assert.Equal(1u, g.Stats.Refits);  // calibrated at 30 frames: GarmentFit.Shape (default) keeps the cut
+
+            // Cut for the skeleton instead: a second refit once the tracker has calibrated.
+            ContextDesc d = ContextDesc.CreateDefault();
+            d.GarmentFit = GarmentFit.Skeleton;
+            using (var fitted = new Context(d))
+            using (Garment f = fitted.AddGarment(Small()))
+            {
+                StepFrames(fitted, 29);
+                Assert.Equal(0u, f.Stats.Refits);
+                StepFrames(fitted, 2, 29);
+                Assert.Equal(1u, f.Stats.Refits);
+                ReadAndCheck(f);
+            }
 
             // The same shape again changes nothing.
             var before = new Vector3f[vertices];

@@ -92,12 +92,12 @@ namespace Drape
     /// <summary>drape_garment_fit: what proportions garments are cut for.</summary>
     public enum GarmentFit : int
     {
+        /// <summary>DRAPE_GARMENT_FIT_SHAPE: the body shape's standard proportions only. The default.</summary>
+        Shape = 0,
         /// <summary>DRAPE_GARMENT_FIT_SKELETON: the tracked person's. Once the tracker has calibrated the bone
         /// lengths, every garment is cut again for their bones and torso (GarmentStats.Refits counts it;
-        /// particles and triangles stay, the rest shape changes). The default.</summary>
-        Skeleton = 0,
-        /// <summary>DRAPE_GARMENT_FIT_SHAPE: the body shape's standard proportions only; no refit at calibration.</summary>
-        Shape = 1,
+        /// particles and triangles stay, the rest shape changes).</summary>
+        Skeleton = 1,
     }
 
     /// <summary>drape_sex.</summary>
@@ -281,7 +281,7 @@ namespace Drape
         public float TeleportDistanceM;
         /// <summary>proxy_rule (int32_t in C); default <see cref="Drape.ProxyRule.Drape"/>.</summary>
         public ProxyRule ProxyRule;
-        /// <summary>garment_fit (int32_t in C); default <see cref="Drape.GarmentFit.Skeleton"/>.</summary>
+        /// <summary>garment_fit (int32_t in C); default <see cref="Drape.GarmentFit.Shape"/>.</summary>
         public GarmentFit GarmentFit;
 
         /// <summary>The library's defaults (drape_context_desc_init).</summary>

@@ -138,16 +138,18 @@ typedef enum drape_proxy_rule {
 
 /* What proportions garments are cut for (drape_context_desc.garment_fit). */
 typedef enum drape_garment_fit {
+  /* The body shape's standard proportions (drape_context_set_body_shape), whatever the skeleton.
+   * Default. */
+  DRAPE_GARMENT_FIT_SHAPE = 0,
   /* The tracked person's. Until the tracker has calibrated the bone lengths (calibration_frames),
-   * garments are cut for the body shape's standard proportions; then every garment is cut again
-   * for this person: the rest pose takes their bone lengths and the geometry of their torso (spine,
-   * hip and shoulder joints), and the garments are refitted to it as after a shape change
-   * (drape_garment_stats.refits counts it; particles and triangles stay, the rest shape changes).
-   * No refit when the person's rest pose is within 1 cm of the standard one. Default. */
-  DRAPE_GARMENT_FIT_SKELETON = 0,
-  /* The body shape's standard proportions only (drape_context_set_body_shape), whatever the
-   * skeleton: no refit at calibration. */
-  DRAPE_GARMENT_FIT_SHAPE = 1,
+   * garments are cut for the shape's standard proportions; then every garment is cut again for this
+   * person: the rest pose takes their bone lengths and their torso's geometry (spine, hip and
+   * shoulder joints) averaged over the calibration window, template garments are made again on it
+   * with their first layout, OBJ garments carried to it (drape_garment_stats.refits counts it;
+   * particles and triangles stay, the rest shape changes). No refit when the person's rest pose is
+   * within 1 cm of the standard one. Less stretch on most shared takes at 2 000 particles, more on
+   * some (skirts on the Kinect takes, coarse garments): docs/garments.md. */
+  DRAPE_GARMENT_FIT_SKELETON = 1,
   DRAPE_GARMENT_FIT_FORCE32 = 0x7fffffff
 } drape_garment_fit;
 
@@ -170,7 +172,7 @@ typedef struct drape_context_desc {
                                     frame's dt) is reported as a teleport; (0, 100]; 0.5 */
   int32_t proxy_rule;            /* drape_proxy_rule: how tracking ellipsoids are built;
                                     default DRAPE_PROXY_RULE_DRAPE */
-  int32_t garment_fit;           /* drape_garment_fit; default DRAPE_GARMENT_FIT_SKELETON (0) */
+  int32_t garment_fit;           /* drape_garment_fit; default DRAPE_GARMENT_FIT_SHAPE (0) */
 } drape_context_desc;
 
 /* Fills `desc` with defaults and struct_size. */

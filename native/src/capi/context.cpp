@@ -68,7 +68,7 @@ drape_result validateContextDesc(const drape_context_desc& d, std::string& err) 
   } else if ((r = range("max_deviation_m", d.max_deviation_m, 0.0f, 10.0f)) != DRAPE_OK) {
   } else if ((r = range("teleport_distance_m", d.teleport_distance_m, 1e-6f, 100.0f)) != DRAPE_OK) {
   } else if (d.garment_fit != DRAPE_GARMENT_FIT_SKELETON && d.garment_fit != DRAPE_GARMENT_FIT_SHAPE) {
-    s << "context desc: garment_fit = " << d.garment_fit << " is not 0 (skeleton) or 1 (shape)";
+    s << "context desc: garment_fit = " << d.garment_fit << " is not 0 (shape) or 1 (skeleton)";
     r = DRAPE_ERROR_OUT_OF_RANGE;
   } else if (d.proxy_rule != DRAPE_PROXY_RULE_PAPER && d.proxy_rule != DRAPE_PROXY_RULE_DRAPE) {
     s << "context desc: proxy_rule = " << d.proxy_rule << " is not 0 (paper) or 1 (drape)";
