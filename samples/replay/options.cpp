@@ -53,6 +53,17 @@ constexpr GarmentName kGarmentNames[] = {
 // Substeps per 1/30 s frame: substep_hz = 30 * N must stay within the library's [30, 20000].
 constexpr unsigned long kMaxSubsteps = 666;
 
+// An option with two named values (`a` -> va, `b` -> vb): sets `out`, or says what was expected.
+bool parseChoice(const std::string& name, const std::string& value, const char* a, int32_t va, const char* b,
+                 int32_t vb, int32_t& out, std::string& error, const char* note = "") {
+  if (value == a || value == b) {
+    out = value == a ? va : vb;
+    return true;
+  }
+  error = name + " '" + value + "' is not '" + a + "' or '" + b + "'" + note;
+  return false;
+}
+
 bool parseLayout(const std::string& text, int32_t& out) {
   if (text == "auto") out = DRAPE_LAYOUT_AUTO;
   else if (text == "kinect1") out = DRAPE_LAYOUT_KINECT1;
@@ -193,25 +204,13 @@ bool parseOptions(int argc, const char* const* argv, Options& o, std::string& er
         return false;
       }
     } else if (name == "--proxy-rule") {
-      if (!takeValue()) return false;
-      if (value == "paper") {
-        o.proxy_rule = DRAPE_PROXY_RULE_PAPER;
-      } else if (value == "drape") {
-        o.proxy_rule = DRAPE_PROXY_RULE_DRAPE;
-      } else {
-        error = "--proxy-rule '" + value + "' is not 'paper' or 'drape'";
+      if (!takeValue() ||
+          !parseChoice(name, value, "paper", DRAPE_PROXY_RULE_PAPER, "drape", DRAPE_PROXY_RULE_DRAPE, o.proxy_rule, error))
         return false;
-      }
     } else if (name == "--garment-fit") {
-      if (!takeValue()) return false;
-      if (value == "skeleton") {
-        o.garment_fit = DRAPE_GARMENT_FIT_SKELETON;
-      } else if (value == "shape") {
-        o.garment_fit = DRAPE_GARMENT_FIT_SHAPE;
-      } else {
-        error = "--garment-fit '" + value + "' is not 'skeleton' or 'shape'";
+      if (!takeValue() || !parseChoice(name, value, "shape", DRAPE_GARMENT_FIT_SHAPE, "skeleton",
+                                       DRAPE_GARMENT_FIT_SKELETON, o.garment_fit, error))
         return false;
-      }
     } else if (name == "--fidelity-every") {
       if (!takeValue()) return false;
       if (!parseUint(value, 0, 0xffffffffUL, o.fidelity_every)) {
@@ -246,15 +245,9 @@ bool parseOptions(int argc, const char* const* argv, Options& o, std::string& er
         return false;
       }
     } else if (name == "--solver") {
-      if (!takeValue()) return false;
-      if (value == "xpbd") {
-        o.solver = DRAPE_SOLVER_XPBD;
-      } else if (value == "massspring") {
-        o.solver = DRAPE_SOLVER_MASS_SPRING;
-      } else {
-        error = "--solver '" + value + "' is not 'xpbd' or 'massspring' (the paper's mass-spring)";
+      if (!takeValue() || !parseChoice(name, value, "xpbd", DRAPE_SOLVER_XPBD, "massspring", DRAPE_SOLVER_MASS_SPRING,
+                                       o.solver, error, " (the paper's mass-spring)"))
         return false;
-      }
       o.solver_given = true;
     } else if (name == "--substeps") {
       if (!takeValue()) return false;

@@ -94,9 +94,10 @@ class Context {
   void refreshBvh();
 
   std::unique_ptr<BodyModel> restBody_;  // rest pose of the current shape, for garments
-  // Garments are cut on the rest pose with the person's bones once the tracker has calibrated them
-  // (DRAPE_GARMENT_FIT_SKELETON; before that, the shape's standard proportions): fitBones_ says which restBody() builds (garmentRestPose), from
-  // the bone lengths and torso pose of the calibration fitted last; restPoseUsed_ is its pose.
+  // With DRAPE_GARMENT_FIT_SKELETON, garments are cut on the rest pose with the person's bones once
+  // the tracker has calibrated them (before that, the shape's standard proportions). fitBones_ says
+  // which restBody() builds (garmentRestPose): from the bone lengths and averaged torso of the
+  // calibration fitted last; restPoseUsed_ is the pose it was built on.
   bool fitBones_ = false;
   std::array<float, kBoneCount> fittedBones_{};
   SkeletonPose fittedTorso_{};

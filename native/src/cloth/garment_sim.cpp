@@ -315,8 +315,9 @@ std::unique_ptr<GarmentSim> GarmentSim::refitted(const BodyModel& body_rest,
     // skinning below does it.
     GarmentMesh mesh;
     std::string why;
+    // (The replay takes the attachments from the layout; the triangles and the count are checked.)
     if (makeGarmentTemplate(body_rest, o.tmpl, mesh, why, nullptr, &o.layout) && mesh.indices == o.mesh.indices &&
-        mesh.positions.size() == o.mesh.positions.size() && mesh.pinned == o.mesh.pinned) {
+        mesh.positions.size() == o.mesh.positions.size()) {
       std::unique_ptr<GarmentSim> g = create(mesh, o.topology, kind_, params_, o.dress_time_s, body_rest,
                                              rest_ellipsoids, ellipsoid_chains, err);
       if (g) g->origin_ = origin_;

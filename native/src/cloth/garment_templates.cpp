@@ -511,10 +511,11 @@ class Builder {
 // shorter than the mesh spacing (0.1 mm next to 2 cm ones). Such an edge has no say in the shape,
 // but measured as stretch over its rest length it dominates every maximum, and its tiny mass
 // stiffens the solve. Merge the ends of every edge shorter than `tol` (union-find, the lower
-// index survives; a pinned end stays pinned) and drop triangles that collapse. `roots` (optional):
-// receives each vertex's survivor, or with `replay` gives them (a cut for another body welds what
-// the first cut welded; false when they do not fit this mesh).
-bool weldShortEdges(GarmentMesh& m, float tol, std::vector<uint32_t>* roots = nullptr, bool replay = false) {
+// index survives; a pinned end stays pinned) and drop triangles that collapse. `record` (optional)
+// receives each vertex's survivor; `replay` (optional) gives them instead of `tol` (a cut for
+// another body welds what the first cut welded; false when they do not fit this mesh).
+bool weldShortEdges(GarmentMesh& m, float tol, std::vector<uint32_t>* record = nullptr,
+                    const std::vector<uint32_t>* replay = nullptr) {
   const size_t n = m.positions.size();
   std::vector<uint32_t> parent(n);
   for (uint32_t i = 0; i < n; ++i) parent[i] = i;
@@ -524,10 +525,10 @@ bool weldShortEdges(GarmentMesh& m, float tol, std::vector<uint32_t>* roots = nu
   };
   bool any = false;
   if (replay) {
-    if (!roots || roots->size() != n) return false;
+    if (replay->size() != n) return false;
     for (uint32_t i = 0; i < n; ++i) {
-      const uint32_t r = (*roots)[i];
-      if (r > i || (*roots)[r] != r) return false;  // survivors are the lowest index of their group
+      const uint32_t r = (*replay)[i];
+      if (r > i || (*replay)[r] != r) return false;  // survivors are the lowest index of their group
       parent[i] = r;
       any = any || r != i;
     }
@@ -543,9 +544,9 @@ bool weldShortEdges(GarmentMesh& m, float tol, std::vector<uint32_t>* roots = nu
         any = true;
       }
     }
-    if (roots) {
-      roots->resize(n);
-      for (uint32_t i = 0; i < n; ++i) (*roots)[i] = root(i);
+    if (record) {
+      record->resize(n);
+      for (uint32_t i = 0; i < n; ++i) (*record)[i] = root(i);
     }
   }
   if (!any) return true;
@@ -673,8 +674,7 @@ bool makeGarmentTemplate(const BodyModel& body, const GarmentTemplateParams& p, 
     builder.setLayout(nullptr, replay);
     builder.build(replay->h, mesh);
     builder.pushOut(mesh, EllipsoidCollider::kDefaultMargin + 0.002f);
-    std::vector<uint32_t> roots = replay->weld_root;
-    const bool fits = builder.replayed() && weldShortEdges(mesh, 0.0f, &roots, true) &&
+    const bool fits = builder.replayed() && weldShortEdges(mesh, 0.0f, nullptr, &replay->weld_root) &&
                       replay->pinned.size() == replay->pin_ring.size() &&
                       std::all_of(replay->pinned.begin(), replay->pinned.end(),
                                   [&](uint32_t v) { return v < mesh.positions.size(); });
