@@ -310,39 +310,47 @@ TEST(OpenClKernels, FrameMatchesXpbdStep) {
   p.collision_stride = 2;
   p.drag = 0.3f;
   p.wind = Vec3(0.5f, 0.0f, 0.2f);
-  XpbdSolver cpu(t), cpu2(t);
-  ASSERT_TRUE(cpu2.setParams(p, err));
-  for (size_t i = 0; i < t.particleCount(); ++i) cpu2.mutablePositions()[i].x() += 1e-6f;
+  // The CPU's own divergence: two runs nudged by 1 um (along x, along z) at the start; the
+  // larger of their distances from the unnudged run is the reference (one nudge alone is a
+  // noisy estimate of how fast this scene amplifies rounding).
+  XpbdSolver cpu(t), nudged[2] = {XpbdSolver(t), XpbdSolver(t)};
+  for (int k = 0; k < 2; ++k) {
+    ASSERT_TRUE(nudged[k].setParams(p, err));
+    for (size_t i = 0; i < t.particleCount(); ++i) nudged[k].mutablePositions()[i][k == 0 ? 0 : 2] += 1e-6f;
+  }
   auto gpu = ClXpbdSolver::create(rt, t, {}, {}, err);
   ASSERT_TRUE(gpu) << err;
   ASSERT_TRUE(cpu.setParams(p, err));
   ASSERT_TRUE(gpu->setParams(p, err));
   EllipsoidCollider collider;
   uint32_t contacts = 0;
+  float chaos = 0.0f;  // the largest self-divergence so far
   for (int f = 0; f < 20; ++f) {
     const float a = 0.05f * static_cast<float>(f), b = 0.05f * static_cast<float>(f + 1);
     const Ellipsoid e0 = makeEllipsoid(Vec3(0.1f * a, -0.35f + a, 0.0f), Vec3(0.3f, 0.2f, 0.25f), a, Vec3(0, 1, 0));
     const Ellipsoid e1 = makeEllipsoid(Vec3(0.1f * b, -0.35f + b, 0.0f), Vec3(0.3f, 0.2f, 0.25f), b, Vec3(0, 1, 0));
     ASSERT_TRUE(cpu.setColliderMotion(&collider, &e0, &e1, 1, 0.004f, err));
     ASSERT_TRUE(gpu->setColliderMotion(&e0, &e1, 1, 0.004f, {}, err));
-    ASSERT_TRUE(cpu2.setColliderMotion(&collider, &e0, &e1, 1, 0.004f, err));
-    ASSERT_TRUE(cpu2.step(1.0f / 30.0f, 10));
+    for (XpbdSolver& s : nudged) {
+      ASSERT_TRUE(s.setColliderMotion(&collider, &e0, &e1, 1, 0.004f, err));
+      ASSERT_TRUE(s.step(1.0f / 30.0f, 10));
+    }
     ASSERT_TRUE(cpu.step(1.0f / 30.0f, 10));
     ASSERT_TRUE(gpu->step(1.0f / 30.0f, 10)) << gpu->lastError();
     float worst = 0.0f;
     for (size_t i = 0; i < t.particleCount(); ++i)
       worst = std::max(worst, (gpu->positions()[i] - cpu.positions()[i]).head<3>().norm());
-    float chaos = 0.0f;
-    for (size_t i = 0; i < t.particleCount(); ++i)
-      chaos = std::max(chaos, (cpu2.positions()[i] - cpu.positions()[i]).head<3>().norm());
+    for (const XpbdSolver& s : nudged)
+      for (size_t i = 0; i < t.particleCount(); ++i)
+        chaos = std::max(chaos, (s.positions()[i] - cpu.positions()[i]).head<3>().norm());
     // Float-rounding level while nothing has amplified it yet; then within 5x of what a 1 um
-    // nudge of the initial state does to the CPU run itself (measured: 1.5-3.5x): the kernel
+    // nudge of the initial state does to the CPU run itself (measured: 0.1-2.9x): the kernel
     // diverges from the CPU no faster than the CPU diverges from itself.
     if (f < 3) EXPECT_LT(worst, 1e-5f) << "frame " << f;
     EXPECT_LT(worst, 5.0f * chaos + 1e-5f) << "frame " << f << ", CPU self-divergence " << chaos;
     const float c0 = static_cast<float>(cpu.lastCollisionStats().contacts);
     // The same contacts while the runs agree to float rounding; then as close as the positions.
-    if (f < 8) EXPECT_EQ(gpu->lastCollisionStats().contacts, cpu.lastCollisionStats().contacts) << "frame " << f;
+    if (worst < 1e-5f) EXPECT_EQ(gpu->lastCollisionStats().contacts, cpu.lastCollisionStats().contacts) << "frame " << f;
     EXPECT_NEAR(static_cast<float>(gpu->lastCollisionStats().contacts), c0, 0.05f * c0 + 5.0f) << "frame " << f;
     contacts += cpu.lastCollisionStats().contacts;
   }

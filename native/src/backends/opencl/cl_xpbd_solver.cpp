@@ -62,8 +62,9 @@ std::unique_ptr<ClXpbdSolver> ClXpbdSolver::create(std::shared_ptr<ClRuntime> ru
   s->pin_target4_.resize(s->pin_index_.size());
   s->group_offsets_.push_back(0);
   const GarmentTopology& t = s->topology_;
-  for (const DistanceConstraints* c : {&t.stretch, &t.shear, &t.bend})
-    appendGroups(*c, 0.0f, s->constraints_, s->compliance_, s->group_offsets_);
+  const DistanceConstraints* kinds[3] = {&t.stretch, &t.shear, &t.bend};
+  for (uint8_t kind : kDistanceKindOrder)  // the CPU solver's order (xpbd_solver.h)
+    appendGroups(*kinds[kind], 0.0f, s->constraints_, s->compliance_, s->group_offsets_);
   s->distance_groups_ = static_cast<uint32_t>(s->group_offsets_.size() - 1);
   s->group_offsets_.push_back(static_cast<uint32_t>(s->constraints_.size()));
   appendGroups(t.tether, 0.0f, s->constraints_, s->compliance_, s->group_offsets_);
@@ -208,7 +209,7 @@ bool ClXpbdSolver::setParams(const XpbdParams& p, std::string& error) {
   const GarmentTopology& t = topology_;
   size_t k = 0;
   const DistanceConstraints* kinds[3] = {&t.stretch, &t.shear, &t.bend};
-  for (int kind = 0; kind < 3; ++kind)
+  for (uint8_t kind : kDistanceKindOrder)
     for (size_t c = 0; c < kinds[kind]->a.size(); ++c) compliance_[k++] = by_kind[kind];
   for (; k < compliance_.size(); ++k) compliance_[k] = p.tether_compliance;
   inv_w_h2_ = -1.0f;  // recompute inv_w at the next step
