@@ -58,25 +58,8 @@ void DCL_FRAME_BODY(__global const DrapeClGarment* g, DCL_XS float4* x, __global
       x[p] = (float4)(a.xyz + pin_t * (b.xyz - a.xyz), x[p].w);
     }
     barrier(CLK_LOCAL_MEM_FENCE | CLK_GLOBAL_MEM_FENCE);
-    /* 2. Constraint passes: tethers (one-sided), then the distance colour
-     * groups (stretch last: XpbdSolver's order, kDistanceKindOrder in xpbd_solver.h). */
+    /* 2. Constraint passes: distance colour groups, then tethers (one-sided). */
     for (int it = 0; it < g->iterations; ++it) {
-      for (uint c = 0; c < g->tether_groups; ++c) {
-        const uint begin = groups[g->tether_group_offset + c];
-        const uint end = groups[g->tether_group_offset + c + 1];
-        for (uint k = begin + lid; k < end; k += lsize) {
-          const DrapeClConstraint cst = constraints[k];
-          float4 pa = x[cst.a];
-          const float3 d = pa.xyz - x[cst.b].xyz;
-          const float len2 = dot(d, d);
-          if (!(len2 > 1e-18f)) continue;
-          const float y = rsqrt(len2);
-          const float c_len = fmax(len2 * y - cst.rest * g->tether_scale, 0.0f);
-          pa.xyz -= (pa.w * c_len * y * cst.inv_w) * d;
-          x[cst.a] = pa;
-        }
-        barrier(CLK_LOCAL_MEM_FENCE | CLK_GLOBAL_MEM_FENCE);
-      }
       for (uint c = 0; c < g->distance_groups; ++c) {
         const uint begin = groups[g->distance_group_offset + c];
         const uint end = groups[g->distance_group_offset + c + 1];
@@ -92,6 +75,22 @@ void DCL_FRAME_BODY(__global const DrapeClGarment* g, DCL_XS float4* x, __global
           pb.xyz += (pb.w * sc) * d;
           x[cst.a] = pa;
           x[cst.b] = pb;
+        }
+        barrier(CLK_LOCAL_MEM_FENCE | CLK_GLOBAL_MEM_FENCE);
+      }
+      for (uint c = 0; c < g->tether_groups; ++c) {
+        const uint begin = groups[g->tether_group_offset + c];
+        const uint end = groups[g->tether_group_offset + c + 1];
+        for (uint k = begin + lid; k < end; k += lsize) {
+          const DrapeClConstraint cst = constraints[k];
+          float4 pa = x[cst.a];
+          const float3 d = pa.xyz - x[cst.b].xyz;
+          const float len2 = dot(d, d);
+          if (!(len2 > 1e-18f)) continue;
+          const float y = rsqrt(len2);
+          const float c_len = fmax(len2 * y - cst.rest * g->tether_scale, 0.0f);
+          pa.xyz -= (pa.w * c_len * y * cst.inv_w) * d;
+          x[cst.a] = pa;
         }
         barrier(CLK_LOCAL_MEM_FENCE | CLK_GLOBAL_MEM_FENCE);
       }

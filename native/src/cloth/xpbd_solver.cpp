@@ -238,8 +238,9 @@ void XpbdSolver::buildBatches() {
   distance_ = Batches{};
   tethers_ = Batches{};
   distance_kind_.clear();
-  // kDistanceKindOrder (xpbd_solver.h): stretch last, so that a substep's pass ends with the
-  // structural edges as close to their rest lengths as one Gauss–Seidel pass gets them.
+  // kDistanceKindOrder (xpbd_solver.h): stretch after shear and bend, so that a substep's pass
+  // leaves the structural edges as close to their rest lengths as one Gauss–Seidel pass gets
+  // them (only the tethers, inequalities that act on few particles, come after).
   const DistanceConstraints* kinds[3] = {&topology_.stretch, &topology_.shear, &topology_.bend};
   for (uint8_t k : kDistanceKindOrder) {
     appendPadded(*kinds[k], 0.0f, dummy, &distance_kind_, k, distance_.a, distance_.b,
@@ -435,8 +436,8 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
     const Vec3 at = pin_start_[k] + pin_t * (pin_target_[k] - pin_start_[k]);
     x[topology_.pinned[k]].head<3>() = at;
   }
-  // 2. One XPBD iteration (alpha~ = alpha / h^2): tethers, then shear, bend and stretch colour by
-  // colour (one list): kDistanceKindOrder.
+  // 2. One XPBD iteration (alpha~ = alpha / h^2): shear, bend and stretch colour by colour (one
+  // list, kDistanceKindOrder), then tethers.
   const float inv_h2 = 1.0f / (h * h);
   if (inv_h2 != inv_w_h2_) {  // h changed (or params): refresh 1 / (w_a + w_b + alpha~)
     inv_w_h2_ = inv_h2;
@@ -456,10 +457,10 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
     }
   }
   for (int it = 0; it < p.iterations; ++it) {  // 1 by default: the method's single pass
-    project<true>(x, tethers_.a.data(), tethers_.b.data(), tethers_.rest.data(),
-                  tethers_.inv_w.data(), tethers_.a.size(), p.tether_scale);
     project<false>(x, distance_.a.data(), distance_.b.data(), distance_.rest.data(),
                    distance_.inv_w.data(), distance_.a.size(), 1.0f);
+    project<true>(x, tethers_.a.data(), tethers_.b.data(), tethers_.rest.data(),
+                  tethers_.inv_w.data(), tethers_.a.size(), p.tether_scale);
   }
   // 3. Collision against the tracking ellipsoids.
   if (collider != nullptr) {

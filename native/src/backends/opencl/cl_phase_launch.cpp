@@ -134,10 +134,8 @@ cl_int ClPhaseKernels::enqueue(ClRuntime& runtime, const ClPhaseBuffers& b, cons
     arg(project_, 9, sub);
     for (int it = 0; it < iterations; ++it) {
       arg(project_, 10, static_cast<cl_int>(it));
-      // Tethers first, then the distance groups (XpbdSolver's order, kDistanceKindOrder).
-      for (uint32_t k = 0; k < distance + tether; ++k) {
-        const bool is_tether = k < tether;
-        const uint32_t c = is_tether ? distance + k : k - tether;  // row 2 + c of the plan
+      for (uint32_t c = 0; c < distance + tether; ++c) {
+        const bool is_tether = c >= distance;
         arg(project_, 6, static_cast<cl_uint>(2 + c));
         arg(project_, 7, static_cast<cl_uint>(is_tether ? c - distance : c));
         arg(project_, 8, static_cast<cl_uint>(is_tether ? 1 : 0));
