@@ -40,6 +40,26 @@ bool ColliderMotion::set(EllipsoidCollider* collider, const Ellipsoid* start, co
     identical_ = start[k].centre == end[k].centre && start[k].radii == end[k].radii &&
                  start[k].rotation == end[k].rotation;
   }
+  slerp_.resize(static_cast<size_t>(count));
+  if (!identical_) {
+    // Eigen's QuaternionBase::slerp, the part that does not depend on t (interpolateEllipsoidPose
+    // normalises both quaternions first).
+    const float one = 1.0f - Eigen::NumTraits<float>::epsilon();
+    for (int k = 0; k < count; ++k) {
+      Slerp& q = slerp_[static_cast<size_t>(k)];
+      q.a = Quat(start[k].rotation);
+      q.b = Quat(end[k].rotation);
+      q.a.normalize();
+      q.b.normalize();
+      q.d = q.a.dot(q.b);
+      const float abs_d = std::abs(q.d);
+      q.linear = abs_d >= one;
+      if (!q.linear) {
+        q.theta = std::acos(abs_d);
+        q.sin_theta = std::sin(q.theta);
+      }
+    }
+  }
   return true;
 }
 
@@ -63,7 +83,25 @@ EllipsoidCollider* ColliderMotion::beginSpan(int s0, int s1, int n) {
   if (t1 == 1.0f) {
     b_ = end_;
   } else {
-    for (int k = 0; k < count_; ++k) b_[k] = interpolateEllipsoidPose(start_[k], end_[k], t1);
+    for (int k = 0; k < count_; ++k) {
+      // interpolateEllipsoidPose(start_[k], end_[k], t1) with the slerp's t-free part from set().
+      const Ellipsoid& a = start_[k];
+      const Ellipsoid& b = end_[k];
+      const Slerp& q = slerp_[static_cast<size_t>(k)];
+      Ellipsoid& e = b_[k];
+      e.centre = a.centre + t1 * (b.centre - a.centre);
+      e.radii = a.radii + t1 * (b.radii - a.radii);
+      float scale0, scale1;
+      if (q.linear) {
+        scale0 = 1.0f - t1;
+        scale1 = t1;
+      } else {
+        scale0 = std::sin((1.0f - t1) * q.theta) / q.sin_theta;
+        scale1 = std::sin(t1 * q.theta) / q.sin_theta;
+      }
+      if (q.d < 0.0f) scale1 = -scale1;
+      e.rotation = Quat(scale0 * q.a.coeffs() + scale1 * q.b.coeffs()).toRotationMatrix();
+    }
   }
   collider_->setEllipsoids(a_.data(), b_.data(), count_, margin_);
   return collider_;

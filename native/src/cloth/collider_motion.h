@@ -37,6 +37,15 @@ class ColliderMotion {
   int count_ = 0;
   float margin_ = EllipsoidCollider::kDefaultMargin;
   bool identical_ = false;  // start == end: no interpolation needed
+  // Per ellipsoid, what interpolateEllipsoidPose's slerp computes from the two rotations alone
+  // (unit quaternions, their dot product and angle), computed once per step instead of once per
+  // collision span: the same operations on the same values, so the same bits.
+  struct Slerp {
+    Quat a, b;
+    float d = 1.0f, theta = 0.0f, sin_theta = 0.0f;
+    bool linear = true;  // |d| >= 1 - epsilon: Eigen's slerp blends linearly
+  };
+  std::vector<Slerp> slerp_;
 };
 
 }  // namespace drape

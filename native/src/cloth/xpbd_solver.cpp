@@ -2,7 +2,9 @@
 
 #include "common/cpu.h"
 
+#include <algorithm>
 #include <chrono>
+#include <limits>
 #include <cmath>
 #include <utility>
 
@@ -189,6 +191,14 @@ __attribute__((target("avx"))) void projectBatchesAvx(Vec4* x, const uint32_t* A
       s = _mm256_mul_ps(_mm256_sub_ps(one, _mm256_mul_ps(r, y)), _mm256_loadu_ps(inv_w + k));
     }
     s = _mm256_and_ps(ok, s);
+    if (kTether) {
+      // Most tethers are slack (inactive inequalities): when every lane's correction is zero and
+      // its d finite, the stores would write back what was read; skip them (same bits).
+      const __m256 acts = _mm256_or_ps(_mm256_cmp_ps(s, zero, _CMP_NEQ_UQ),
+                                       _mm256_cmp_ps(len2, _mm256_set1_ps(std::numeric_limits<float>::infinity()),
+                                                     _CMP_NLT_UQ));
+      if (_mm256_movemask_ps(acts) == 0) continue;
+    }
     const __m256 sa = _mm256_mul_ps(aw, s);
     ax = _mm256_sub_ps(ax, _mm256_mul_ps(sa, dx));
     ay = _mm256_sub_ps(ay, _mm256_mul_ps(sa, dy));
@@ -213,6 +223,50 @@ void project(Vec4* x, const uint32_t* A, const uint32_t* B, const float* rest, c
 #endif
   projectBatches<kTether>(x, A, B, rest, inv_w, m, scale);
 }
+
+#if DRAPE_XPBD_AVX
+// a . a of each particle (xyzw) of a pair in one 256-bit register, in all four lanes of its
+// half, summed as Eigen's SSE squaredNorm sums a packet: (x + z) + (y + w).
+__attribute__((target("avx"), always_inline)) inline __m256 squaredNorms2(__m256 a) {
+  const __m256 t = _mm256_mul_ps(a, a);
+  const __m256 u = _mm256_add_ps(t, _mm256_permute_ps(t, _MM_SHUFFLE(1, 0, 3, 2)));  // x+z, y+w, z+x, w+y
+  return _mm256_add_ps(u, _mm256_permute_ps(u, _MM_SHUFFLE(2, 3, 0, 1)));
+}
+
+// The fused velocity update + next prediction of XpbdSolver::substep for two particles at a
+// time (AoS: one 256-bit register holds particles i and i + 1, unaligned loads and stores: the
+// arrays are 16-byte aligned), from `i` on: the same operations
+// per lane in the same order as the scalar loop, so the same bits. Returns where it stopped: n,
+// or the first particle of a pair the speed clamp would act on (the caller runs that pair the
+// scalar way, then calls again) or the odd last particle.
+__attribute__((target("avx"))) size_t fusedPairsAvx(Vec4* x, Vec4* prev, Vec4* vel, Vec4* capture,
+                                                     size_t i, size_t n, float scale, const Vec4& hg,
+                                                     const Vec4& wind, float h_drag, float h,
+                                                     float max_speed2) {
+  const __m256 vscale = _mm256_set1_ps(scale), vh = _mm256_set1_ps(h), vdrag = _mm256_set1_ps(h_drag);
+  const __m256 vhg = _mm256_broadcast_ps(reinterpret_cast<const __m128*>(hg.data()));
+  const __m256 vwind = _mm256_broadcast_ps(reinterpret_cast<const __m128*>(wind.data()));
+  const __m256 limit = _mm256_set1_ps(max_speed2), zero = _mm256_setzero_ps();
+  const bool clamp = max_speed2 > 0.0f;
+  for (; i + 2 <= n; i += 2) {
+    const __m256 xi = _mm256_loadu_ps(x[i].data());
+    __m256 v = _mm256_mul_ps(_mm256_sub_ps(xi, _mm256_loadu_ps(prev[i].data())), vscale);
+    const __m256 vp = _mm256_add_ps(v, _mm256_add_ps(vhg, _mm256_mul_ps(vdrag, _mm256_sub_ps(vwind, v))));
+    if (clamp && _mm256_movemask_ps(_mm256_or_ps(_mm256_cmp_ps(squaredNorms2(v), limit, _CMP_GT_OQ),
+                                                 _mm256_cmp_ps(squaredNorms2(vp), limit, _CMP_GT_OQ))))
+      return i;
+    // Pinned particles (w = 0) keep their position and the first velocity.
+    const __m256 pinned = _mm256_permute_ps(_mm256_cmp_ps(xi, zero, _CMP_EQ_OQ), _MM_SHUFFLE(3, 3, 3, 3));
+    if (capture) _mm256_storeu_ps(capture[i].data(), xi);
+    _mm256_storeu_ps(prev[i].data(), xi);
+    // and/andnot/or rather than blendv: GCC lowered that blend lane by lane here.
+    _mm256_storeu_ps(vel[i].data(), _mm256_or_ps(_mm256_and_ps(pinned, v), _mm256_andnot_ps(pinned, vp)));
+    const __m256 moved = _mm256_add_ps(xi, _mm256_mul_ps(vh, vp));
+    _mm256_storeu_ps(x[i].data(), _mm256_or_ps(_mm256_and_ps(pinned, xi), _mm256_andnot_ps(pinned, moved)));
+  }
+  return i;
+}
+#endif
 
 }  // namespace
 
@@ -478,7 +532,7 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
   // Then (predict_next) the next substep's prediction in the same pass over the particles:
   // one pass instead of two, the same arithmetic per particle.
   const float scale = std::exp(-p.damping * h) / h;
-  for (size_t i = 0; i < n; ++i) {
+  auto update = [&](size_t i) DRAPE_LAMBDA_INLINE {
     Vec4 v = (x[i] - prev[i]) * scale;
     if (max_speed2 > 0.0f) {
       const float s2 = v.squaredNorm();
@@ -486,12 +540,24 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
     }
     if (!predict_next) {
       vel[i] = v;
-      continue;
+      return;
     }
     const Vec4 xi = x[i];
     if (capture) capture[i] = xi;
     predict(i, xi, v);
+  };
+  size_t i = 0;
+#if DRAPE_XPBD_AVX
+  // Two particles at a time where the CPU has AVX; a pair the speed clamp acts on (rare) and an
+  // odd last particle go the scalar way.
+  if (predict_next && paired_update_ && cpuHasAvx()) {
+    while ((i = fusedPairsAvx(x, prev, vel, capture, i, n, scale, hg, wind, h_drag, h, max_speed2)) < n) {
+      const size_t stop = std::min(n, i + 2);
+      for (; i < stop; ++i) update(i);
+    }
   }
+#endif
+  for (; i < n; ++i) update(i);
   if (timing_) {
     const double collided = timings_.collision_ns - collision_before;
     timings_.constraints_ns += nsBetween(start, Clock::now()) - collided;

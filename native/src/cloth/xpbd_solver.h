@@ -124,6 +124,9 @@ class XpbdSolver {
   const CollisionStats& lastCollisionStats() const { return collision_stats_; }
   // Off by default (two clock reads per substep part when on).
   void setTimingEnabled(bool on) { timing_ = on; }
+  // On by default where the CPU has AVX: the per-substep velocity update and prediction two
+  // particles at a time (the same bits as one at a time). Off: one at a time (tests compare).
+  void setPairedUpdate(bool on) { paired_update_ = on; }
   const XpbdTimings& lastTimings() const { return timings_; }
 
  private:
@@ -165,6 +168,7 @@ class XpbdSolver {
   ColliderMotion motion_;
   CollisionStats collision_stats_;
   bool timing_ = false;
+  bool paired_update_ = true;
   XpbdTimings timings_;
 };
 
