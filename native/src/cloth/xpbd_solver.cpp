@@ -4,8 +4,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <limits>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #if defined(__SSE2__) || defined(_M_X64)
@@ -234,11 +234,11 @@ __attribute__((target("avx"), always_inline)) inline __m256 squaredNorms2(__m256
 }
 
 // The fused velocity update + next prediction of XpbdSolver::substep for two particles at a
-// time (AoS: one 256-bit register holds particles i and i + 1, unaligned loads and stores: the
-// arrays are 16-byte aligned), from `i` on: the same operations
-// per lane in the same order as the scalar loop, so the same bits. Returns where it stopped: n,
-// or the first particle of a pair the speed clamp would act on (the caller runs that pair the
-// scalar way, then calls again) or the odd last particle.
+// time, from `i` on (AoS: one 256-bit register holds particles i and i + 1; unaligned loads and
+// stores, the arrays are 16-byte aligned): the same operations per lane in the same order as the
+// scalar loop, so the same bits. Returns where it stopped: n, or the first particle of a pair the
+// speed clamp would act on (the caller runs that pair the scalar way, then calls again) or the
+// odd last particle.
 __attribute__((target("avx"))) size_t fusedPairsAvx(Vec4* x, Vec4* prev, Vec4* vel, Vec4* capture,
                                                      size_t i, size_t n, float scale, const Vec4& hg,
                                                      const Vec4& wind, float h_drag, float h,
