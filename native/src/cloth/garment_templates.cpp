@@ -686,8 +686,9 @@ bool makeGarmentTemplate(const BodyModel& body, const GarmentTemplateParams& p, 
     mesh.pin_ring = replay->pin_ring;
     separateShortEdges(mesh, 0.25f * replay->h);
   } else {
-    // Resolution: spacing h adjusted until the particle count is within 4 % of the target.
-    builder.setLayout(&layout, nullptr);
+    // Resolution: spacing h adjusted until the particle count is within 4 % of the target. The
+    // layout is recorded only for a caller that keeps it.
+    builder.setLayout(record ? &layout : nullptr, nullptr);
     const float target = static_cast<float>(p.target_particles);
     float h = 0.03f;
     for (int it = 0; it < 12; ++it) {
@@ -697,9 +698,11 @@ bool makeGarmentTemplate(const BodyModel& body, const GarmentTemplateParams& p, 
       h *= std::clamp(std::sqrt(n / target), 0.7f, 1.4f);
     }
     builder.pushOut(mesh, EllipsoidCollider::kDefaultMargin + 0.002f);
-    weldShortEdges(mesh, 0.25f * h, &layout.weld_root);
-    layout.pinned = mesh.pinned;
-    layout.pin_ring = mesh.pin_ring;
+    weldShortEdges(mesh, 0.25f * h, record ? &layout.weld_root : nullptr);
+    if (record) {
+      layout.pinned = mesh.pinned;
+      layout.pin_ring = mesh.pin_ring;
+    }
   }
   builder.finishPins(mesh);
   for (const Vec3& x : mesh.positions) {

@@ -171,6 +171,7 @@ __attribute__((target("avx"))) void projectBatchesAvx(Vec4* x, const uint32_t* A
   const __m256 vscale = _mm256_set1_ps(scale), zero = _mm256_setzero_ps();
   const __m256 tiny2 = _mm256_set1_ps(1e-18f), half = _mm256_set1_ps(0.5f);
   const __m256 three = _mm256_set1_ps(3.0f), one = _mm256_set1_ps(1.0f);
+  const __m256 inf = _mm256_set1_ps(std::numeric_limits<float>::infinity());
   for (size_t k = 0; k < m; k += 8) {
     __m256 ax, ay, az, aw, bx, by, bz, bw;
     gather8(x, A + k, ax, ay, az, aw);
@@ -194,9 +195,7 @@ __attribute__((target("avx"))) void projectBatchesAvx(Vec4* x, const uint32_t* A
     if (kTether) {
       // Most tethers are slack (inactive inequalities): when every lane's correction is zero and
       // its d finite, the stores would write back what was read; skip them (same bits).
-      const __m256 acts = _mm256_or_ps(_mm256_cmp_ps(s, zero, _CMP_NEQ_UQ),
-                                       _mm256_cmp_ps(len2, _mm256_set1_ps(std::numeric_limits<float>::infinity()),
-                                                     _CMP_NLT_UQ));
+      const __m256 acts = _mm256_or_ps(_mm256_cmp_ps(s, zero, _CMP_NEQ_UQ), _mm256_cmp_ps(len2, inf, _CMP_NLT_UQ));
       if (_mm256_movemask_ps(acts) == 0) continue;
     }
     const __m256 sa = _mm256_mul_ps(aw, s);
