@@ -144,6 +144,7 @@ class XpbdSolver {
   // order as three passes), each constraint carrying its kind's compliance.
   struct Batches {
     std::vector<uint32_t> a, b;
+    std::vector<uint32_t> a_off, b_off;  // a, b times sizeof(Vec4): the AVX kernel's addresses
     std::vector<float> rest, compliance;
     std::vector<float> w_ab;   // w_a + w_b (w_a for tethers): fixed, so a new h costs one
                                // division per constraint and no gathers
