@@ -740,7 +740,8 @@ TEST(Collider, BroadPhaseOnOffIdentical) {
 // start position, the broad phase; lanes with a non-finite start position, pinned or NaN
 // particles and particles far from everything mixed in.
 TEST(Collider, EightAtOnceMatchesOneAtATimeBitForBit) {
-  for (int n : {40, 130}) {
+  // 40, 130 and 250 ellipsoids: one, three and four bitmask words per grid cell.
+  for (int n : {40, 130, 250}) {
     Scene s = randomScene(n, test::repeatsUnderSanitizers(4000, 4), 700u + static_cast<unsigned>(n));
     const float nan = std::numeric_limits<float>::quiet_NaN();
     for (size_t i = 0; i < s.x.size(); i += 37) s.prev[i].x() = nan;      // no start position

@@ -548,8 +548,7 @@ CollisionStats EllipsoidCollider::collide(Eigen::Vector4f* positions,
   const bool grouped = particle_masks_ != nullptr && !allowed_.empty() &&
                        groups_.size() == shapes_.size() && shapes_.size() <= static_cast<size_t>(kMaxGridEllipsoids);
   size_t i = 0;
-  if (p.batch8)
-    for (; i + 8 <= count && collideEight(positions, previous, i, p, grouped, st); i += 8) {}
+  if (p.batch8) i = collideEights(positions, previous, count, p, grouped, st);
   for (; i < count; ++i) {
     if (!mayTouch(positions, previous, i, swept)) continue;
     const Vec3 x = positions[i].head<3>();

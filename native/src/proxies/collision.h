@@ -168,10 +168,11 @@ class EllipsoidCollider {
   }
   // Whether particle i of collide() can touch anything (collision_internal.h).
   bool mayTouch(const Eigen::Vector4f* positions, const Eigen::Vector4f* previous, size_t i, bool swept) const;
-  // collide() for particles [begin, begin + 8) (CollisionParams::batch8); false when the CPU has
-  // no AVX (nothing done).
-  bool collideEight(Eigen::Vector4f* positions, const Eigen::Vector4f* previous, size_t begin,
-                    const CollisionParams& p, bool grouped, CollisionStats& st) const;
+  // collide() for particles [0, count - count % 8), eight at a time (CollisionParams::batch8).
+  // Returns how many it handled: 0 (nothing done) when the CPU has no AVX or the grid takes no
+  // more than kMaxGridEllipsoids.
+  size_t collideEights(Eigen::Vector4f* positions, const Eigen::Vector4f* previous, size_t count,
+                       const CollisionParams& p, bool grouped, CollisionStats& st) const;
   Vec3 respond(const Shape& s, const Vec3& x, const Vec3& q, float r2, ContactResponse mode,
                Vec3& q_contact) const;
   void refreshQuick(int k);
