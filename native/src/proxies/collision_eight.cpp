@@ -90,6 +90,10 @@ DRAPE_AVX_INLINE void orCells(const uint64_t* cells, int dim_x, int dim_y, const
   }
   for (int w = 0; w < W; ++w) out[w] = acc[w];
 }
+// v where `mask` lanes are all ones, else off.
+DRAPE_AVX_INLINE __m256 select8(__m256 mask, __m256 v, __m256 off) {
+  return _mm256_or_ps(_mm256_and_ps(mask, v), _mm256_andnot_ps(mask, off));
+}
 DRAPE_AVX_INLINE float hmin8(__m256 v) {
   __m128 m = _mm_min_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
   m = _mm_min_ps(m, _mm_movehl_ps(m, m));
@@ -176,11 +180,10 @@ __attribute__((target("avx"))) size_t EllipsoidCollider::collideEights(Eigen::Ve
     _mm256_store_ps(X.v, px), _mm256_store_ps(Y.v, py), _mm256_store_ps(Z.v, pz);
     _mm256_store_ps(X0.v, p0x), _mm256_store_ps(Y0.v, p0y), _mm256_store_ps(Z0.v, p0z);
     // The joint box of the lanes taking part (the others set to an empty box first).
+    // and/andnot/or rather than blendv: GCC 12 lowered that blend lane by lane here.
     const __m256 on = laneMask8(active);
-    const Vec3 lo(hmin8(_mm256_blendv_ps(inf, lox, on)), hmin8(_mm256_blendv_ps(inf, loy, on)),
-                  hmin8(_mm256_blendv_ps(inf, loz, on)));
-    const Vec3 hi(hmax8(_mm256_blendv_ps(minf, hix, on)), hmax8(_mm256_blendv_ps(minf, hiy, on)),
-                  hmax8(_mm256_blendv_ps(minf, hiz, on)));
+    const Vec3 lo(hmin8(select8(on, lox, inf)), hmin8(select8(on, loy, inf)), hmin8(select8(on, loz, inf)));
+    const Vec3 hi(hmax8(select8(on, hix, minf)), hmax8(select8(on, hiy, minf)), hmax8(select8(on, hiz, minf)));
     // Lane j's collision mask in byte j: lane j may touch ellipsoid k when its byte shares a bit
     // with groups_[k] (what allowed_ tabulates, setGroups), so one AND and one byte compare give
     // the lanes allowed for k. Lanes not taking part keep 0. The lanes' joint candidates are those
