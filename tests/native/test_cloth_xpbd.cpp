@@ -200,6 +200,35 @@ TEST(ClothXpbd, PairedUpdateMatchesOneAtATimeBitForBit) {
   EXPECT_EQ(clamped_paired, clamped_single);
 }
 
+TEST(ClothXpbd, TransformIsTheRigidMapOfEveryParticleBitForBit) {
+  // transform() two particles at a time (AVX) against the per-particle Eigen expressions it
+  // replaced: positions and velocities after some motion (so prev differs from x), an odd
+  // particle count (the tail), inverse masses (w) kept, pinned particles included.
+  XpbdSolver s(square(25, false));
+  std::string error;
+  XpbdParams p;
+  p.wind = Vec3(0.3f, 0.0f, 0.1f);
+  p.drag = 0.5f;
+  ASSERT_TRUE(s.setParams(p, error)) << error;
+  for (int f = 0; f < 5; ++f) ASSERT_TRUE(s.step(1.0f / 30.0f, 10));
+  const size_t n = s.particleCount();
+  ASSERT_EQ(n % 2, 1u);
+  std::vector<Eigen::Vector4f> x(s.positions(), s.positions() + n), v(s.velocities(), s.velocities() + n);
+  const Mat3 R = Eigen::AngleAxisf(0.7f, Vec3(0.2f, 1.0f, -0.4f).normalized()).toRotationMatrix();
+  const Vec3 pivot(0.31f, -0.2f, 0.77f), t(0.05f, 0.01f, -0.12f);
+  const float scale = 0.83f;
+  s.transform(R, pivot, t, scale);
+  const Vec3 shift = pivot + t;
+  for (size_t i = 0; i < n; ++i) {
+    Eigen::Vector4f xe = x[i], ve = v[i];
+    xe.head<3>() = R * (Vec3(x[i].head<3>()) - pivot) + shift;
+    ve.head<3>() = scale * (R * Vec3(v[i].head<3>()));
+    SCOPED_TRACE(i);
+    EXPECT_EQ(std::memcmp(xe.data(), s.positions()[i].data(), sizeof xe), 0);
+    EXPECT_EQ(std::memcmp(ve.data(), s.velocities()[i].data(), sizeof ve), 0);
+  }
+}
+
 TEST(ClothXpbd, ColliderMotionSpansAreInterpolateEllipsoidPoseBitForBit) {
   // ColliderMotion keeps the slerp's t-free part (unit quaternions, their angle) per step; every
   // span's ellipsoids must still be exactly interpolateEllipsoidPose's: turned a little (slerp),

@@ -276,6 +276,44 @@ __attribute__((target("avx"))) size_t fusedPairsAvx(Vec4* x, Vec4* prev, Vec4* v
   }
   return i;
 }
+
+// c0 d.x + (c1 d.y + c2 d.z) for each 128-bit half's d (c0..c2: a 3 x 3 matrix's columns), the
+// order Eigen's unrolled sum of three products takes (it splits a length-3 sum as 1 + 2).
+__attribute__((target("avx"), always_inline)) inline __m256 rotatePair(__m256 c0, __m256 c1, __m256 c2, __m256 d) {
+  return _mm256_add_ps(_mm256_mul_ps(c0, _mm256_permute_ps(d, 0x00)),
+                       _mm256_add_ps(_mm256_mul_ps(c1, _mm256_permute_ps(d, 0x55)),
+                                     _mm256_mul_ps(c2, _mm256_permute_ps(d, 0xAA))));
+}
+
+// XpbdSolver::transform's rigid map for particles [0, n - n % 2), two per 256-bit register:
+// x = R (x - pivot) + shift and prev likewise, v = s (R v), each product as Eigen's 3 x 3 times
+// 3-vector sums it, R_i0 d_x + (R_i1 d_y + R_i2 d_z) (no FMA; s R_ik for v), and the w lanes kept:
+// the same bits. Returns how many particles it did.
+__attribute__((target("avx"))) size_t transformPairsAvx(Vec4* x, Vec4* prev, Vec4* vel, size_t n, const Mat3& R,
+                                                        const Vec3& pivot, const Vec3& shift, float velocity_scale) {
+  const __m256 c0 = _mm256_setr_ps(R(0, 0), R(1, 0), R(2, 0), 0.0f, R(0, 0), R(1, 0), R(2, 0), 0.0f);
+  const __m256 c1 = _mm256_setr_ps(R(0, 1), R(1, 1), R(2, 1), 0.0f, R(0, 1), R(1, 1), R(2, 1), 0.0f);
+  const __m256 c2 = _mm256_setr_ps(R(0, 2), R(1, 2), R(2, 2), 0.0f, R(0, 2), R(1, 2), R(2, 2), 0.0f);
+  const __m256 vpivot = _mm256_setr_ps(pivot.x(), pivot.y(), pivot.z(), 0.0f, pivot.x(), pivot.y(), pivot.z(), 0.0f);
+  const __m256 vshift = _mm256_setr_ps(shift.x(), shift.y(), shift.z(), 0.0f, shift.x(), shift.y(), shift.z(), 0.0f);
+  // Eigen folds the scalar of s (R v) into the matrix: (s R_ik) v_k, summed as above.
+  const __m256 vs = _mm256_set1_ps(velocity_scale);
+  const __m256 s0 = _mm256_mul_ps(vs, c0), s1 = _mm256_mul_ps(vs, c1), s2 = _mm256_mul_ps(vs, c2);
+  // Lanes x, y, z of each particle (w from the input).
+  const __m256 xyz = _mm256_castsi256_ps(_mm256_setr_epi32(-1, -1, -1, 0, -1, -1, -1, 0));
+  size_t i = 0;
+  for (; i + 2 <= n; i += 2) {
+    for (Vec4* p : {x, prev}) {
+      const __m256 a = _mm256_loadu_ps(p[i].data());
+      const __m256 moved = _mm256_add_ps(rotatePair(c0, c1, c2, _mm256_sub_ps(a, vpivot)), vshift);
+      _mm256_storeu_ps(p[i].data(), _mm256_or_ps(_mm256_and_ps(xyz, moved), _mm256_andnot_ps(xyz, a)));
+    }
+    const __m256 v = _mm256_loadu_ps(vel[i].data());
+    const __m256 turned = rotatePair(s0, s1, s2, v);
+    _mm256_storeu_ps(vel[i].data(), _mm256_or_ps(_mm256_and_ps(xyz, turned), _mm256_andnot_ps(xyz, v)));
+  }
+  return i;
+}
 #endif
 
 }  // namespace
@@ -469,7 +507,12 @@ bool XpbdSolver::step(float dt, int substeps) {
 
 void XpbdSolver::transform(const Mat3& R, const Vec3& pivot, const Vec3& t, float velocity_scale) {
   const Vec3 shift = pivot + t;
-  for (size_t i = 0; i < particleCount(); ++i) {
+  size_t first = 0;
+#if DRAPE_XPBD_AVX
+  if (cpuHasAvx())
+    first = transformPairsAvx(x_.data(), prev_.data(), v_.data(), particleCount(), R, pivot, shift, velocity_scale);
+#endif
+  for (size_t i = first; i < particleCount(); ++i) {
     x_[i].head<3>() = R * (Vec3(x_[i].head<3>()) - pivot) + shift;
     prev_[i].head<3>() = R * (Vec3(prev_[i].head<3>()) - pivot) + shift;
     v_[i].head<3>() = velocity_scale * (R * Vec3(v_[i].head<3>()));
