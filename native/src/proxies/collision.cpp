@@ -50,9 +50,9 @@ inline void applyFriction(const Mat3& to_unit_end, const Vec3& c_end, const Mat3
 // F = r2 - 1 and F' = -2 sum q_i^2 / b_i need no division. A resting contact (|q| ~ 0.999)
 // converges in one or two steps. False when it does not converge in 8 steps (near the medial
 // surface of a flat ellipsoid, or deeper points): the caller then uses the double solver.
-inline bool closestInsideFloat(const Vec4& b, const Vec4& q, float r2, Vec3& local, Vec3& qc) {
+// e = sqrt(b) per lane (Quick::radii2_sqrt, computed once per ellipsoid and substep).
+inline bool closestInsideFloat(const Vec4& b, const Vec4& e, const Vec4& q, float r2, Vec3& local, Vec3& qc) {
   if (!(r2 >= 0.64f)) return false;
-  const Vec4 e = b.cwiseSqrt();
   const Vec4 y = e.cwiseProduct(q);  // local point
   const Vec4 a = y.cwiseProduct(e);  // e_i y_i
   float lo = -b.head<3>().minCoeff(), hi = 0.0f, t = 0.0f;
@@ -263,6 +263,7 @@ void EllipsoidCollider::refreshQuick(int k) {
   q.end_min = lift(s.end_min);
   q.end_max = lift(s.end_max);
   q.radii2 = lift(s.radii.cwiseProduct(s.radii));
+  q.radii2_sqrt = q.radii2.cwiseSqrt();
   q.inside_tol2 = s.inside_tol2;
   q.graze = s.graze;
 }
@@ -297,7 +298,7 @@ Vec3 EllipsoidCollider::respond(const Shape& s, const Vec3& x, const Vec3& q, fl
   }
   Vec3 y;
   const Quick& qk = quick_[static_cast<size_t>(&s - shapes_.data())];
-  if (!closestInsideFloat(qk.radii2, lift(q), r2, y, q_contact)) {
+  if (!closestInsideFloat(qk.radii2, qk.radii2_sqrt, lift(q), r2, y, q_contact)) {
     const Vec3 local = mulvT(s.rotation, x - s.end.centre);
     y = closestPointOnEllipsoidFast(s.radii, local);
     q_contact = y.cwiseQuotient(s.radii);

@@ -129,6 +129,7 @@ class EllipsoidCollider {
     Eigen::Vector4f start_c, start_u[3];  // start centre, columns of start to_unit
     Eigen::Vector4f swept_min, swept_max, end_min, end_max;
     Eigen::Vector4f radii2;               // inflated end radii squared (exact response)
+    Eigen::Vector4f radii2_sqrt;          // sqrt of radii2 lane by lane (not the radii: rounding)
     float inside_tol2 = 1.0f, graze = 0.0f;
   };
   using Mask = uint64_t[kMaxGridEllipsoids / 64];
