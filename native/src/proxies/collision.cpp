@@ -79,9 +79,6 @@ inline bool closestInsideFloat(const Vec4& b, const Vec4& e, const Vec4& q, floa
   return false;
 }
 
-// A swept contact is answered at the entry point when the discrete response would land more
-// than 45 degrees (round the unit sphere) away from it.
-constexpr float kDeepContactCos = 0.70710678f;
 
 // Where the unit-space segment q0 -> q1 (q0 outside or on the sphere) first meets the unit
 // sphere, normalised onto it.

@@ -174,6 +174,15 @@ class EllipsoidCollider {
   // more than kMaxGridEllipsoids.
   size_t collideEights(Eigen::Vector4f* positions, const Eigen::Vector4f* previous, size_t count,
                        const CollisionParams& p, bool grouped, CollisionStats& st) const;
+  // contact() for the lanes of `lanes` of collideEights' block against ellipsoid k, where each is
+  // inside (discrete contact) and the response is Exact, eight lanes at once: the same arithmetic
+  // in the same order per lane. Returns the lanes it answered (their x updated, st.contacts
+  // counted); the rest (closest point not found in float, or a deep contact that may need the
+  // entry point) are left for contact(). The arrays are collideEights' lanes (8 floats each).
+  int exactContactsEight(int k, int lanes, const float* q1x, const float* q1y, const float* q1z, const float* r2,
+                         const float* q0x, const float* q0y, const float* q0z, const float* q0sq,
+                         const float* x0x, const float* x0y, const float* x0z, bool cont, bool friction,
+                         const CollisionParams& p, float* xx, float* xy, float* xz, CollisionStats& st) const;
   Vec3 respond(const Shape& s, const Vec3& x, const Vec3& q, float r2, ContactResponse mode,
                Vec3& q_contact) const;
   void refreshQuick(int k);

@@ -19,6 +19,10 @@
 namespace drape {
 namespace collision_internal {
 
+// A swept contact is answered at the entry point when the discrete response would land more
+// than 45 degrees (round the unit sphere) away from it.
+constexpr float kDeepContactCos = 0.70710678f;
+
 inline int lowestBit(uint64_t m) {
 #if defined(_MSC_VER)
   unsigned long index = 0;
