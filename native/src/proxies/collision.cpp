@@ -486,13 +486,13 @@ void EllipsoidCollider::resolveParticle(Vec3& x, const Vec3& x0, bool has_prev,
 }
 
 void EllipsoidCollider::settle(Vec3& x, const Candidates* first, const CollisionParams& p, bool use_grid,
-                               const uint64_t* allowed, CollisionStats& st) const {
+                               const uint64_t* allowed, CollisionStats& st, int first_pass) const {
   bool moved = true;
   // Further sequential passes (no friction): a push out of one ellipsoid may land in another.
   // The first pass's candidates still cover x when it stayed in the same cells (the usual case).
   // Gathering again instead gives the same tests in the same order: an ellipsoid whose end box
   // holds x is in x's cell.
-  for (int pass = 1; pass < kSequentialPasses && moved; ++pass) {
+  for (int pass = first_pass; pass < kSequentialPasses && moved; ++pass) {
     moved = false;
     const Vec3 xp = x;
     Candidates again;

@@ -157,8 +157,15 @@ class EllipsoidCollider {
                        const uint64_t* allowed, CollisionStats& stats) const;
   // resolveParticle after pass 0 moved x: the further sequential passes and the escape step.
   // first: pass 0's candidates for this particle, or null (then gathered where needed).
+  // first_pass: the sequential pass to start at (kSequentialPasses: only the final check, for a
+  // particle whose earlier passes ran elsewhere and moved it).
   void settle(Vec3& x, const Candidates* first, const CollisionParams& p, bool use_grid,
-              const uint64_t* allowed, CollisionStats& stats) const;
+              const uint64_t* allowed, CollisionStats& stats, int first_pass = 1) const;
+  // settle()'s first pass for the lanes of collideEights' block whose joint candidates cover them
+  // (collision_eight.cpp); returns the lanes it settled.
+  int settleEight(const int* ks, int n, int lanes, uint64_t lane_masks, bool mixed, float* xx, float* xy,
+                  float* xz, const CollisionParams& p, bool use_grid, size_t begin, bool grouped,
+                  CollisionStats& st) const;
   // The ellipsoids a particle with collision mask `mask` may touch (allowed_'s row), and particle
   // i's row when collide() uses groups (null otherwise).
   const uint64_t* allowedRow(uint8_t mask) const {

@@ -304,27 +304,91 @@ __attribute__((target("avx"))) size_t EllipsoidCollider::collideEights(Eigen::Ve
         moved |= 1 << j;
       }
     }
-    while (moved) {
-      const int j = __builtin_ctz(static_cast<unsigned>(moved));
-      moved &= moved - 1;
+    if (!moved) continue;
+    // settle() for the lanes pass 0 moved: its first sequential pass on the eight lanes at once
+    // where the joint candidates' cells cover a lane's position (then, narrowed to the lane's
+    // groups, they are what settle would test: an ellipsoid whose box holds the point is in its
+    // cell), in the same order with the same arithmetic; the rest one lane at a time.
+    int together = 0;
+    for (int bits = moved; bits; bits &= bits - 1) {
+      const int j = __builtin_ctz(static_cast<unsigned>(bits));
+      if (covers(c, Vec3(X.v[j], Y.v[j], Z.v[j]))) together |= 1 << j;
+    }
+    const int settled = together ? settleEight(ks, candidates, together, mixed ? lane_masks : 0, mixed, X.v, Y.v,
+                                               Z.v, p, use_grid, begin, grouped, st)
+                                 : 0;
+    for (int bits = moved; bits; bits &= bits - 1) {
+      const int j = __builtin_ctz(static_cast<unsigned>(bits));
       Vec3 x(X.v[j], Y.v[j], Z.v[j]);
-      // The joint candidates narrowed to this lane's groups: where they cover x, settle tests the
-      // same ellipsoids in the same order as after a gather of its own (collision.cpp, settle).
       const size_t i = begin + static_cast<size_t>(j);
-      const uint64_t* allowed = allowedFor(grouped, i);
-      Candidates mine = c;
-      if (mixed) {
-        if (mine.all) {
-          mine.allowed = allowed;
-        } else {
-          for (int w = 0; w < words_; ++w) mine.mask[w] &= allowed[w];
+      if (!((settled >> j) & 1)) {
+        const uint64_t* allowed = allowedFor(grouped, i);
+        Candidates mine = c;
+        if (mixed) {
+          if (mine.all) {
+            mine.allowed = allowed;
+          } else {
+            for (int w = 0; w < words_; ++w) mine.mask[w] &= allowed[w];
+          }
         }
+        settle(x, &mine, p, use_grid, allowed, st);
       }
-      settle(x, &mine, p, use_grid, allowed, st);
       if (x != Vec3(positions[i].head<3>())) positions[i].head<3>() = x;
     }
   }
   return end;
+}
+
+// settle()'s first sequential pass for the lanes `lanes` of collideEights' block (their joint
+// candidates ks[0..n) cover their positions): per candidate in order, the lanes allowed for it
+// (lane_masks when the block's masks are mixed), the box test at the pass's start position, the
+// inside test at the lane's current position (pass 0's unit-space arithmetic: mulq and a 4-lane
+// squared norm); a lane inside is answered by respond(), one lane at a time (rare). Lanes that
+// moved then finish as settle() does after its passes (firstContaining, escape). Returns `lanes`:
+// every lane given is settled, x in xx/xy/xz.
+__attribute__((target("avx"))) int EllipsoidCollider::settleEight(const int* ks, int n, int lanes, uint64_t lane_masks,
+                                                                  bool mixed, float* xx, float* xy, float* xz,
+                                                                  const CollisionParams& p, bool use_grid,
+                                                                  size_t begin, bool grouped, CollisionStats& st) const {
+  static_assert(kSequentialPasses == 2, "settleEight runs settle's one sequential pass");
+  const __m256 XP = _mm256_load_ps(xx), YP = _mm256_load_ps(xy), ZP = _mm256_load_ps(xz);
+  int moved = 0;
+  for (int m = 0; m < n; ++m) {
+    const int k = ks[m];
+    const Quick& qk = quick_[static_cast<size_t>(k)];
+    int on = lanes;
+    if (mixed) {
+      const uint64_t shared = lane_masks & (0x0101010101010101ull * groups_[static_cast<size_t>(k)]);
+      const int none = _mm_movemask_epi8(_mm_cmpeq_epi8(_mm_cvtsi64_si128(static_cast<long long>(shared)),
+                                                         _mm_setzero_si128())) & 0xFF;
+      on &= ~none;
+    }
+    on &= _mm256_movemask_ps(boxes8(XP, YP, ZP, XP, YP, ZP, qk.end_min, qk.end_max));
+    if (!on) continue;
+    st.tests += static_cast<uint32_t>(__builtin_popcount(static_cast<unsigned>(on)));
+    __m256 qx, qy, qz;
+    unitSpace8(qk.end_u, qk.end_c, _mm256_load_ps(xx), _mm256_load_ps(xy), _mm256_load_ps(xz), qx, qy, qz);
+    const __m256 r2 = dot8(qx, qy, qz, qx, qy, qz);
+    int inside = on & _mm256_movemask_ps(_mm256_cmp_ps(r2, bcast(qk.inside_tol2), _CMP_LT_OQ));
+    if (!inside) continue;
+    Lanes QX, QY, QZ, R2;
+    _mm256_store_ps(QX.v, qx), _mm256_store_ps(QY.v, qy), _mm256_store_ps(QZ.v, qz), _mm256_store_ps(R2.v, r2);
+    for (; inside; inside &= inside - 1) {
+      const int j = __builtin_ctz(static_cast<unsigned>(inside));
+      Vec3 qc;
+      const Vec3 x = respond(shapes_[static_cast<size_t>(k)], Vec3(xx[j], xy[j], xz[j]), Vec3(QX.v[j], QY.v[j], QZ.v[j]),
+                             R2.v[j], p.response, qc);
+      xx[j] = x.x(), xy[j] = x.y(), xz[j] = x.z();
+      moved |= 1 << j;
+    }
+  }
+  for (; moved; moved &= moved - 1) {
+    const int j = __builtin_ctz(static_cast<unsigned>(moved));
+    Vec3 x(xx[j], xy[j], xz[j]);
+    settle(x, nullptr, p, use_grid, allowedFor(grouped, begin + static_cast<size_t>(j)), st, kSequentialPasses);
+    xx[j] = x.x(), xy[j] = x.y(), xz[j] = x.z();
+  }
+  return lanes;
 }
 
 // contact() for inside lanes with the Exact response, eight at once (exactContactsEight in
@@ -464,6 +528,10 @@ __attribute__((target("avx"))) int EllipsoidCollider::exactContactsEight(
 #else
 size_t EllipsoidCollider::collideEights(Eigen::Vector4f*, const Eigen::Vector4f*, size_t, const CollisionParams&,
                                         bool, CollisionStats&) const {
+  return 0;
+}
+int EllipsoidCollider::settleEight(const int*, int, int, uint64_t, bool, float*, float*, float*,
+                                   const CollisionParams&, bool, size_t, bool, CollisionStats&) const {
   return 0;
 }
 int EllipsoidCollider::exactContactsEight(int, int, const float*, const float*, const float*, const float*,
