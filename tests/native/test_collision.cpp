@@ -740,9 +740,22 @@ TEST(Collider, BroadPhaseOnOffIdentical) {
 // start position, the broad phase; lanes with a non-finite start position, pinned or NaN
 // particles and particles far from everything mixed in.
 TEST(Collider, EightAtOnceMatchesOneAtATimeBitForBit) {
-  // 40, 130 and 250 ellipsoids: one, three and four bitmask words per grid cell.
-  for (int n : {40, 130, 250}) {
-    Scene s = randomScene(n, test::repeatsUnderSanitizers(4000, 4), 700u + static_cast<unsigned>(n));
+  // 40, 130 and 250 ellipsoids: one, three and four bitmask words per grid cell; the 40 also
+  // scaled 10x (radii up to 2.2 m: the exact response's Newton iteration then needs its w lane).
+  for (int n : {40, 130, 250, -40}) {
+    Scene s = randomScene(std::abs(n), test::repeatsUnderSanitizers(4000, 4), 700u + static_cast<unsigned>(std::abs(n)));
+    if (n < 0) {
+      for (std::vector<Ellipsoid>* es : {&s.start, &s.end}) {
+        for (Ellipsoid& e : *es) {
+          e.centre *= 10.0f;
+          e.radii *= 10.0f;
+          e.refresh();
+        }
+      }
+      for (std::vector<Vec4>* xs : {&s.x, &s.prev})
+        for (Vec4& x : *xs) x.head<3>() *= 10.0f;
+      n = -n;
+    }
     const float nan = std::numeric_limits<float>::quiet_NaN();
     for (size_t i = 0; i < s.x.size(); i += 37) s.prev[i].x() = nan;      // no start position
     for (size_t i = 5; i < s.x.size(); i += 41) s.x[i].y() = nan;         // skipped

@@ -416,7 +416,9 @@ __attribute__((target("avx"))) int EllipsoidCollider::exactContactsEight(
     Y[i] = _mm256_mul_ps(bcast(e[i]), Q1[i]);
     A[i] = _mm256_mul_ps(Y[i], bcast(e[i]));
   }
-  __m256 lo = bcast(-std::min(std::min(b[0], b[1]), b[2])), hi = zero, t = zero;
+  const float b_min = std::min(std::min(b[0], b[1]), b[2]);
+  const bool w_free = b_min < 1.0f;
+  __m256 lo = bcast(-b_min), hi = zero, t = zero;
   __m256 F = _mm256_sub_ps(R2, one);
   // -2 sum(q^2 / (b + (0, 0, 0, 1))): lanes (x + z) + (y + w), w = 0 / 1.
   __m256 T[3];
@@ -441,7 +443,9 @@ __attribute__((target("avx"))) int EllipsoidCollider::exactContactsEight(
       r[i] = _mm256_div_ps(one, _mm256_add_ps(_mm256_add_ps(B[i], t), zero));
       u[i] = _mm256_mul_ps(A[i], r[i]);
     }
-    const __m256 r3 = _mm256_div_ps(one, _mm256_add_ps(_mm256_add_ps(zero, t), one));
+    // The w lane: a_w = 0, so u_w = 0 / (t + 1) adds exactly nothing while t > -1, which holds
+    // when every b_i < 1 (t stays above -min b): only larger ellipsoids pay for that division.
+    const __m256 r3 = w_free ? one : _mm256_div_ps(one, _mm256_add_ps(_mm256_add_ps(zero, t), one));
     const __m256 u3 = _mm256_mul_ps(zero, r3);
     const __m256 uu[4] = {_mm256_mul_ps(u[0], u[0]), _mm256_mul_ps(u[1], u[1]), _mm256_mul_ps(u[2], u[2]),
                           _mm256_mul_ps(u3, u3)};
