@@ -75,11 +75,12 @@ DRAPE_AVX_INLINE uint64_t byteMask8(__m256 lanes) {
                                         _mm_castps_si128(_mm256_extractf128_ps(lanes, 1)));
   return static_cast<uint64_t>(_mm_cvtsi128_si64(_mm_packs_epi16(words, _mm_setzero_si128())));
 }
-// The OR of the grid cells [lo, hi] (W bitmask words each) into out[0..W): the broad phase's
-// multi-cell gather with the words in registers.
+// The OR of the grid cells [lo, hi] (W bitmask words each), ANDed with `allowed` when given,
+// into out[0..W): the broad phase's gather with the words in registers (and written once: a
+// wider load of words just stored one by one would stall on store forwarding).
 template <int W>
 DRAPE_AVX_INLINE void orCells(const uint64_t* cells, int dim_x, int dim_y, const Eigen::Array4i& lo,
-                              const Eigen::Array4i& hi, uint64_t* out) {
+                              const Eigen::Array4i& hi, const uint64_t* allowed, uint64_t* out) {
   uint64_t acc[W] = {};
   for (int z = lo[2]; z <= hi[2]; ++z) {
     for (int y = lo[1]; y <= hi[1]; ++y) {
@@ -88,6 +89,8 @@ DRAPE_AVX_INLINE void orCells(const uint64_t* cells, int dim_x, int dim_y, const
         for (int w = 0; w < W; ++w) acc[w] |= cell[w];
     }
   }
+  if (allowed)
+    for (int w = 0; w < W; ++w) acc[w] &= allowed[w];
   for (int w = 0; w < W; ++w) out[w] = acc[w];
 }
 // a + (b + c): how Eigen sums three terms (a 3-vector's dot product and squared norm; its
@@ -228,13 +231,11 @@ __attribute__((target("avx"))) size_t EllipsoidCollider::collideEights(Eigen::Ve
       c.lo = cellsOf(lo, cell_origin_, cell_scale_, cell_top_);
       c.hi = cellsOf(hi, cell_origin_, cell_scale_, cell_top_);
       switch (words_) {
-        case 1: orCells<1>(cells_.data(), dims_[0], dims_[1], c.lo, c.hi, c.mask); break;
-        case 2: orCells<2>(cells_.data(), dims_[0], dims_[1], c.lo, c.hi, c.mask); break;
-        case 3: orCells<3>(cells_.data(), dims_[0], dims_[1], c.lo, c.hi, c.mask); break;
-        default: orCells<4>(cells_.data(), dims_[0], dims_[1], c.lo, c.hi, c.mask); break;
+        case 1: orCells<1>(cells_.data(), dims_[0], dims_[1], c.lo, c.hi, joint_allowed, c.mask); break;
+        case 2: orCells<2>(cells_.data(), dims_[0], dims_[1], c.lo, c.hi, joint_allowed, c.mask); break;
+        case 3: orCells<3>(cells_.data(), dims_[0], dims_[1], c.lo, c.hi, joint_allowed, c.mask); break;
+        default: orCells<4>(cells_.data(), dims_[0], dims_[1], c.lo, c.hi, joint_allowed, c.mask); break;
       }
-      if (joint_allowed)
-        for (int w = 0; w < words_; ++w) c.mask[w] &= joint_allowed[w];
     }
     const __m256 x0x = p0x, x0y = p0y, x0z = p0z;
     int moved = 0;
