@@ -87,6 +87,14 @@ DRAPE_AVX_INLINE __m256 row3(float m0, float m1, float m2, __m256 v0, __m256 v1,
 DRAPE_AVX_INLINE __m256 col3(float m0, float m1, float m2, __m256 v0, __m256 v1, __m256 v2) {
   return sum3(_mm256_mul_ps(bcast(m0), v0), _mm256_mul_ps(bcast(m1), v1), _mm256_mul_ps(bcast(m2), v2));
 }
+// Bit j set where byte j of lane_masks (lane j's collision mask) shares a bit with `group`
+// (an ellipsoid's group): one multiply, one AND and one byte compare for eight lanes.
+DRAPE_AVX_INLINE int lanesSharing(uint64_t lane_masks, uint8_t group) {
+  const uint64_t shared = lane_masks & (0x0101010101010101ull * group);
+  const int none = _mm_movemask_epi8(_mm_cmpeq_epi8(_mm_cvtsi64_si128(static_cast<long long>(shared)),
+                                                     _mm_setzero_si128())) & 0xFF;
+  return ~none & 0xFF;
+}
 // v where `mask` lanes are all ones, else off.
 DRAPE_AVX_INLINE __m256 select8(__m256 mask, __m256 v, __m256 off) {
   return _mm256_or_ps(_mm256_and_ps(mask, v), _mm256_andnot_ps(mask, off));

@@ -151,12 +151,7 @@ __attribute__((target("avx"))) size_t EllipsoidCollider::collideEights(Eigen::Ve
       const int k = ks[n];
       const Quick& qk = quick_[static_cast<size_t>(k)];
       int lanes = active;
-      if (mixed) {
-        const uint64_t shared = lane_masks & (0x0101010101010101ull * groups_[static_cast<size_t>(k)]);
-        const int none = _mm_movemask_epi8(_mm_cmpeq_epi8(_mm_cvtsi64_si128(static_cast<long long>(shared)),
-                                                           _mm_setzero_si128())) & 0xFF;
-        lanes &= ~none;
-      }
+      if (mixed) lanes &= lanesSharing(lane_masks, groups_[static_cast<size_t>(k)]);
       // X, Y, Z as contacts with earlier candidates left them.
       const __m256 cx = _mm256_load_ps(X.v), cy = _mm256_load_ps(Y.v), cz = _mm256_load_ps(Z.v);
       // The swept box (fixed per particle) against the ellipsoid's swept box, or the end position

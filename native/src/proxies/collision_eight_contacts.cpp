@@ -31,12 +31,7 @@ __attribute__((target("avx"))) int EllipsoidCollider::settleEight(const int* ks,
     const int k = ks[m];
     const Quick& qk = quick_[static_cast<size_t>(k)];
     int on = lanes;
-    if (mixed) {
-      const uint64_t shared = lane_masks & (0x0101010101010101ull * groups_[static_cast<size_t>(k)]);
-      const int none = _mm_movemask_epi8(_mm_cmpeq_epi8(_mm_cvtsi64_si128(static_cast<long long>(shared)),
-                                                         _mm_setzero_si128())) & 0xFF;
-      on &= ~none;
-    }
+    if (mixed) on &= lanesSharing(lane_masks, groups_[static_cast<size_t>(k)]);
     on &= _mm256_movemask_ps(boxes8(XP, YP, ZP, XP, YP, ZP, qk.end_min, qk.end_max));
     if (!on) continue;
     st.tests += static_cast<uint32_t>(__builtin_popcount(static_cast<unsigned>(on)));
