@@ -4,7 +4,9 @@
 // for bit. Only for functions compiled with target("avx") and called after cpuHasAvx().
 #pragma once
 
-#if (defined(__GNUC__) || defined(__clang__)) && (defined(__x86_64__) || defined(__i386__))
+// x86-64 only: the lane masks move through 64-bit general registers (_mm_cvtsi64_si128), which
+// 32-bit x86 lacks; there the collider runs one particle at a time.
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__)
 #define DRAPE_COLLISION_AVX 1
 #include <immintrin.h>
 
