@@ -79,7 +79,6 @@ inline bool closestInsideFloat(const Vec4& b, const Vec4& e, const Vec4& q, floa
   return false;
 }
 
-
 // Where the unit-space segment q0 -> q1 (q0 outside or on the sphere) first meets the unit
 // sphere, normalised onto it.
 inline Vec3 entryPoint(const Vec3& q0, float q0sq, const Vec3& q1) {
@@ -486,13 +485,13 @@ void EllipsoidCollider::resolveParticle(Vec3& x, const Vec3& x0, bool has_prev,
 }
 
 void EllipsoidCollider::settle(Vec3& x, const Candidates* first, const CollisionParams& p, bool use_grid,
-                               const uint64_t* allowed, CollisionStats& st, int first_pass) const {
+                               const uint64_t* allowed, CollisionStats& st) const {
   bool moved = true;
   // Further sequential passes (no friction): a push out of one ellipsoid may land in another.
   // The first pass's candidates still cover x when it stayed in the same cells (the usual case).
   // Gathering again instead gives the same tests in the same order: an ellipsoid whose end box
   // holds x is in x's cell.
-  for (int pass = first_pass; pass < kSequentialPasses && moved; ++pass) {
+  for (int pass = 1; pass < kSequentialPasses && moved; ++pass) {
     moved = false;
     const Vec3 xp = x;
     Candidates again;
@@ -514,8 +513,12 @@ void EllipsoidCollider::settle(Vec3& x, const Candidates* first, const Collision
       moved = true;
     });
   }
-  // Guarantee: if the last pass moved the particle, check it; still inside -> escape step.
-  if (moved && firstContaining(x, use_grid, allowed, st) >= 0) {
+  if (moved) escapeIfInside(x, p, use_grid, allowed, st);
+}
+
+void EllipsoidCollider::escapeIfInside(Vec3& x, const CollisionParams& p, bool use_grid, const uint64_t* allowed,
+                                       CollisionStats& st) const {
+  if (firstContaining(x, use_grid, allowed, st) >= 0) {
     escape(x, p.response, use_grid, allowed, p.max_escape_m, st);
     ++st.escapes;
   }

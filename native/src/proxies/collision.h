@@ -157,15 +157,17 @@ class EllipsoidCollider {
                        const uint64_t* allowed, CollisionStats& stats) const;
   // resolveParticle after pass 0 moved x: the further sequential passes and the escape step.
   // first: pass 0's candidates for this particle, or null (then gathered where needed).
-  // first_pass: the sequential pass to start at (kSequentialPasses: only the final check, for a
-  // particle whose earlier passes ran elsewhere and moved it).
   void settle(Vec3& x, const Candidates* first, const CollisionParams& p, bool use_grid,
-              const uint64_t* allowed, CollisionStats& stats, int first_pass = 1) const;
-  // settle()'s first pass for the lanes of collideEights' block whose joint candidates cover them
-  // (collision_eight.cpp); returns the lanes it settled.
-  int settleEight(const int* ks, int n, int lanes, uint64_t lane_masks, bool mixed, float* xx, float* xy,
-                  float* xz, const CollisionParams& p, bool use_grid, size_t begin, bool grouped,
-                  CollisionStats& st) const;
+              const uint64_t* allowed, CollisionStats& stats) const;
+  // The sequential passes' guarantee, for a particle their last pass moved: still inside an
+  // ellipsoid -> the escape step.
+  void escapeIfInside(Vec3& x, const CollisionParams& p, bool use_grid, const uint64_t* allowed,
+                      CollisionStats& stats) const;
+  // settle() for the lanes `lanes` of collideEights' block, whose joint candidates ks[0..n) cover
+  // them (collision_eight_contacts.cpp).
+  void settleEight(const int* ks, int n, int lanes, uint64_t lane_masks, bool mixed, float* xx, float* xy,
+                   float* xz, const CollisionParams& p, bool use_grid, size_t begin, bool grouped,
+                   CollisionStats& st) const;
   // The ellipsoids a particle with collision mask `mask` may touch (allowed_'s row), and particle
   // i's row when collide() uses groups (null otherwise).
   const uint64_t* allowedRow(uint8_t mask) const {
@@ -177,8 +179,8 @@ class EllipsoidCollider {
   // Whether particle i of collide() can touch anything (collision_internal.h).
   bool mayTouch(const Eigen::Vector4f* positions, const Eigen::Vector4f* previous, size_t i, bool swept) const;
   // collide() for particles [0, count - count % 8), eight at a time (CollisionParams::batch8).
-  // Returns how many it handled: 0 (nothing done) when the CPU has no AVX or the grid takes no
-  // more than kMaxGridEllipsoids.
+  // Returns how many it handled: 0 (nothing done) when the CPU has no AVX or there are more
+  // ellipsoids than kMaxGridEllipsoids.
   size_t collideEights(Eigen::Vector4f* positions, const Eigen::Vector4f* previous, size_t count,
                        const CollisionParams& p, bool grouped, CollisionStats& st) const;
   // contact() for the lanes of `lanes` of collideEights' block against ellipsoid k, where each is

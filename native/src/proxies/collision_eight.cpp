@@ -215,14 +215,14 @@ __attribute__((target("avx"))) size_t EllipsoidCollider::collideEights(Eigen::Ve
       const int j = __builtin_ctz(static_cast<unsigned>(bits));
       if (covers(c, Vec3(X.v[j], Y.v[j], Z.v[j]))) together |= 1 << j;
     }
-    const int settled = together ? settleEight(ks, candidates, together, mixed ? lane_masks : 0, mixed, X.v, Y.v,
-                                               Z.v, p, use_grid, begin, grouped, st)
-                                 : 0;
+    if (together)
+      settleEight(ks, candidates, together, mixed ? lane_masks : 0, mixed, X.v, Y.v, Z.v, p, use_grid, begin,
+                  grouped, st);
     for (int bits = moved; bits; bits &= bits - 1) {
       const int j = __builtin_ctz(static_cast<unsigned>(bits));
       Vec3 x(X.v[j], Y.v[j], Z.v[j]);
       const size_t i = begin + static_cast<size_t>(j);
-      if (!((settled >> j) & 1)) {
+      if (!((together >> j) & 1)) {
         const uint64_t* allowed = allowedFor(grouped, i);
         Candidates mine = c;
         if (mixed) {

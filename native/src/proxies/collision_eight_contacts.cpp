@@ -18,12 +18,11 @@ using namespace collision_avx;
 // (lane_masks when the block's masks are mixed), the box test at the pass's start position, the
 // inside test at the lane's current position (pass 0's unit-space arithmetic: mulq and a 4-lane
 // squared norm); a lane inside is answered by respond(), one lane at a time (rare). Lanes that
-// moved then finish as settle() does after its passes (firstContaining, escape). Returns `lanes`:
-// every lane given is settled, x in xx/xy/xz.
-__attribute__((target("avx"))) int EllipsoidCollider::settleEight(const int* ks, int n, int lanes, uint64_t lane_masks,
-                                                                  bool mixed, float* xx, float* xy, float* xz,
-                                                                  const CollisionParams& p, bool use_grid,
-                                                                  size_t begin, bool grouped, CollisionStats& st) const {
+// moved then finish as settle() does after its passes (escapeIfInside). x in xx/xy/xz.
+__attribute__((target("avx"))) void EllipsoidCollider::settleEight(const int* ks, int n, int lanes, uint64_t lane_masks,
+                                                                   bool mixed, float* xx, float* xy, float* xz,
+                                                                   const CollisionParams& p, bool use_grid,
+                                                                   size_t begin, bool grouped, CollisionStats& st) const {
   static_assert(kSequentialPasses == 2, "settleEight runs settle's one sequential pass");
   const __m256 XP = _mm256_load_ps(xx), YP = _mm256_load_ps(xy), ZP = _mm256_load_ps(xz);
   int moved = 0;
@@ -54,10 +53,9 @@ __attribute__((target("avx"))) int EllipsoidCollider::settleEight(const int* ks,
   for (; moved; moved &= moved - 1) {
     const int j = __builtin_ctz(static_cast<unsigned>(moved));
     Vec3 x(xx[j], xy[j], xz[j]);
-    settle(x, nullptr, p, use_grid, allowedFor(grouped, begin + static_cast<size_t>(j)), st, kSequentialPasses);
+    escapeIfInside(x, p, use_grid, allowedFor(grouped, begin + static_cast<size_t>(j)), st);
     xx[j] = x.x(), xy[j] = x.y(), xz[j] = x.z();
   }
-  return lanes;
 }
 
 // contact() for inside lanes with the Exact response, eight at once (exactContactsEight in
@@ -89,12 +87,12 @@ __attribute__((target("avx"))) int EllipsoidCollider::exactContactsEight(
   const bool w_free = b_min < 1.0f;
   __m256 lo = bcast(-b_min), hi = zero, t = zero;
   __m256 F = _mm256_sub_ps(R2, one);
-  // -2 sum(q^2 / (b + (0, 0, 0, 1))): lanes (x + z) + (y + w), w = 0 / 1.
+  // -2 sum(q^2 / (b + (0, 0, 0, 1))): lanes (x + z) + (y + w). The w term is 0 / 1 = +0, and
+  // adding +0 (here and below, where the scalar code adds b's w lane 0) changes no value these
+  // sums can take (b > 0, b + t > 0, squares >= 0): it is left out.
   __m256 T[3];
-  for (int i = 0; i < 3; ++i) T[i] = _mm256_div_ps(_mm256_mul_ps(Q1[i], Q1[i]), _mm256_add_ps(B[i], zero));
-  const __m256 T3 = _mm256_div_ps(_mm256_mul_ps(zero, zero), _mm256_add_ps(zero, one));
-  __m256 dF = _mm256_mul_ps(_mm256_set1_ps(-2.0f),
-                            _mm256_add_ps(_mm256_add_ps(T[0], T[2]), _mm256_add_ps(T[1], T3)));
+  for (int i = 0; i < 3; ++i) T[i] = _mm256_div_ps(_mm256_mul_ps(Q1[i], Q1[i]), B[i]);
+  __m256 dF = _mm256_mul_ps(_mm256_set1_ps(-2.0f), _mm256_add_ps(_mm256_add_ps(T[0], T[2]), T[1]));
   const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7FFFFFFF));
   __m256 conv = zero, L[3] = {zero, zero, zero}, QC[3] = {zero, zero, zero};
   for (int it = 0; it < 8; ++it) {
@@ -109,12 +107,12 @@ __attribute__((target("avx"))) int EllipsoidCollider::exactContactsEight(
     t = select8(live, tn, t);
     __m256 r[3], u[3];
     for (int i = 0; i < 3; ++i) {
-      r[i] = _mm256_div_ps(one, _mm256_add_ps(_mm256_add_ps(B[i], t), zero));
+      r[i] = _mm256_div_ps(one, _mm256_add_ps(B[i], t));
       u[i] = _mm256_mul_ps(A[i], r[i]);
     }
     // The w lane: a_w = 0, so u_w = 0 / (t + 1) adds exactly nothing while t > -1, which holds
     // when every b_i < 1 (t stays above -min b): only larger ellipsoids pay for that division.
-    const __m256 r3 = w_free ? one : _mm256_div_ps(one, _mm256_add_ps(_mm256_add_ps(zero, t), one));
+    const __m256 r3 = w_free ? one : _mm256_div_ps(one, _mm256_add_ps(t, one));
     const __m256 u3 = _mm256_mul_ps(zero, r3);
     const __m256 uu[4] = {_mm256_mul_ps(u[0], u[0]), _mm256_mul_ps(u[1], u[1]), _mm256_mul_ps(u[2], u[2]),
                           _mm256_mul_ps(u3, u3)};
@@ -199,10 +197,8 @@ __attribute__((target("avx"))) int EllipsoidCollider::exactContactsEight(
   return done_bits;
 }
 #else
-int EllipsoidCollider::settleEight(const int*, int, int, uint64_t, bool, float*, float*, float*,
-                                   const CollisionParams&, bool, size_t, bool, CollisionStats&) const {
-  return 0;
-}
+void EllipsoidCollider::settleEight(const int*, int, int, uint64_t, bool, float*, float*, float*,
+                                    const CollisionParams&, bool, size_t, bool, CollisionStats&) const {}
 int EllipsoidCollider::exactContactsEight(int, int, const float*, const float*, const float*, const float*,
                                           const float*, const float*, const float*, const float*, const float*,
                                           const float*, const float*, bool, bool, const CollisionParams&, float*,
