@@ -63,13 +63,22 @@ typedef struct {
   float h, inv_n, h_drag, max_speed;
   float max_speed2, velocity_scale, tether_scale, static_friction;
   float kinetic_friction, max_escape, pad0, pad1;
+  /* compliance / h^2 of this frame by constraint kind: alpha[0..2] the distance kinds in their
+   * projection order (kDistanceKindOrder: shear, bend, stretch), alpha[3] the tethers. Kept out of
+   * the constraints so that a new h (a Kinect's frame time varies every frame) changes 16 bytes
+   * here instead of every constraint on the host and its upload. */
+  float alpha[4];
+  dcl_u32 kind_end[2];        /* distance group index where the first / second kind's colours end */
+  dcl_u32 pad2, pad3;
 } DrapeClGarment;
 
-/* A distance or tether constraint: a and b are particle indices within the garment;
- * inv_w = 1 / (w_a + w_b + compliance / h^2) for the frame's h (0 = inert). */
+/* A distance or tether constraint: a and b are particle indices within the garment; w_sum =
+ * w_a + w_b (tethers: w_a, the anchor is pinned). The kernels project with inv_w = 1 / (w_sum +
+ * alpha), alpha = compliance / h^2 of the constraint's kind this frame (DrapeClGarment.alpha),
+ * and 0 when that sum is not positive (inert): the CPU solver's 1 / (w_a + w_b + alpha~). */
 typedef struct {
   dcl_u32 a, b;
-  float rest, inv_w;
+  float rest, w_sum;
 } DrapeClConstraint;
 
 /* The rigid carry of one garment in a batched drape_transform_batch launch: x -> R (x - pivot)
@@ -84,5 +93,23 @@ typedef struct {
 typedef struct {
   dcl_u32 tests, contacts, swept_catches, escapes;
 } DrapeClStats;
+
+#ifdef __OPENCL_C_VERSION__
+/* Device helpers of the constraint record (xpbd_frame.cl, kernels.cl and phases.cl use them).
+ * 1 / (w_a + w_b + alpha~) of a constraint for this frame's alpha~ = compliance / h^2 (0 when
+ * not positive: inert), the CPU solver's inv_w (XpbdSolver, refreshed per step there) in the same
+ * float operations; the program is built with -cl-fp32-correctly-rounded-divide-sqrt. */
+inline float dcl_inv_w(float w_sum, float alpha) {
+  const float w = w_sum + alpha;
+  return w > 0.0f ? 1.0f / w : 0.0f;
+}
+
+/* The alpha~ of distance colour group `group` (or of the tethers) of garment g: the distance
+ * groups run kind by kind in projection order, kind_end[] where each of the first two ends. */
+inline float dcl_group_alpha(__global const DrapeClGarment* g, uint group, uint tether) {
+  if (tether) return g->alpha[3];
+  return group < g->kind_end[0] ? g->alpha[0] : group < g->kind_end[1] ? g->alpha[1] : g->alpha[2];
+}
+#endif
 
 #endif /* DRAPE_CL_TYPES_H */

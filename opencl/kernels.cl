@@ -74,31 +74,34 @@ __kernel void drape_collide(__global const DrapeClGarment* g, __global float4* x
 /* One distance constraint (both ends move) or tether (one-sided: only a moves, and only when
  * stretched past rest * tether_scale) projected in place in x: the Gauss-Seidel step of the
  * per-phase path (drape_phase_project, phases.cl) and of the per-kernel stage below. */
-inline void dcl_project_one(__global float4* x, const DrapeClConstraint c, uint tether, float tether_scale) {
+inline void dcl_project_one(__global float4* x, const DrapeClConstraint c, uint tether, float tether_scale,
+                            float alpha) {
   float4 pa = x[c.a], pb = x[c.b];
   const float3 d = pa.xyz - pb.xyz;
   const float len2 = dot(d, d);
   if (!(len2 > 1e-18f)) return;
   const float y = rsqrt(len2);
+  const float inv_w = dcl_inv_w(c.w_sum, alpha);
   if (tether) {
     const float c_len = fmax(len2 * y - c.rest * tether_scale, 0.0f);
-    pa.xyz -= (pa.w * c_len * y * c.inv_w) * d;
+    pa.xyz -= (pa.w * c_len * y * inv_w) * d;
     x[c.a] = pa;
     return;
   }
-  const float s = (1.0f - c.rest * y) * c.inv_w;
+  const float s = (1.0f - c.rest * y) * inv_w;
   pa.xyz -= (pa.w * s) * d;
   pb.xyz += (pb.w * s) * d;
   x[c.a] = pa;
   x[c.b] = pb;
 }
 
-/* One constraint colour group (tests): constraints [begin, end), one work-item each. */
+/* One constraint colour group (tests): constraints [begin, end), one work-item each, alpha~ as
+ * dcl_inv_w takes it. */
 __kernel void drape_project_group(__global float4* x, __global const DrapeClConstraint* constraints,
-                                  uint begin, uint end, uint tether, float tether_scale) {
+                                  uint begin, uint end, uint tether, float tether_scale, float alpha) {
   const uint k = begin + get_global_id(0);
   if (k >= end) return;
-  dcl_project_one(x, constraints[k], tether, tether_scale);
+  dcl_project_one(x, constraints[k], tether, tether_scale, alpha);
 }
 
 /* Area-weighted unit vertex normals (vertexNormals in body/mesh_metrics.cpp) without atomics:

@@ -124,7 +124,8 @@ __kernel void drape_phase_project(__global const DrapeClGarment* table, uint cou
   __global const DrapeClGarment* g = table + gi;
   if (substep >= g->substeps || iteration >= g->iterations) return;
   const uint first = groups[(tether ? g->tether_group_offset : g->distance_group_offset) + group];
-  dcl_project_one(x + g->particle_offset, constraints[first + j], tether, g->tether_scale);
+  dcl_project_one(x + g->particle_offset, constraints[first + j], tether, g->tether_scale,
+                  dcl_group_alpha(g, group, tether));
 }
 
 /* Collision against the substep's span when the span ends here, then the velocity update.

@@ -63,6 +63,7 @@ void DCL_FRAME_BODY(__global const DrapeClGarment* g, DCL_XS float4* x, __global
       for (uint c = 0; c < g->distance_groups; ++c) {
         const uint begin = groups[g->distance_group_offset + c];
         const uint end = groups[g->distance_group_offset + c + 1];
+        const float alpha = dcl_group_alpha(g, c, 0u);
         for (uint k = begin + lid; k < end; k += lsize) {
           const DrapeClConstraint cst = constraints[k];
           float4 pa = x[cst.a], pb = x[cst.b];
@@ -70,7 +71,7 @@ void DCL_FRAME_BODY(__global const DrapeClGarment* g, DCL_XS float4* x, __global
           const float len2 = dot(d, d);
           if (!(len2 > 1e-18f)) continue;
           const float y = rsqrt(len2);
-          const float sc = (1.0f - cst.rest * y) * cst.inv_w;
+          const float sc = (1.0f - cst.rest * y) * dcl_inv_w(cst.w_sum, alpha);
           pa.xyz -= (pa.w * sc) * d;
           pb.xyz += (pb.w * sc) * d;
           x[cst.a] = pa;
@@ -81,6 +82,7 @@ void DCL_FRAME_BODY(__global const DrapeClGarment* g, DCL_XS float4* x, __global
       for (uint c = 0; c < g->tether_groups; ++c) {
         const uint begin = groups[g->tether_group_offset + c];
         const uint end = groups[g->tether_group_offset + c + 1];
+        const float alpha = g->alpha[3];
         for (uint k = begin + lid; k < end; k += lsize) {
           const DrapeClConstraint cst = constraints[k];
           float4 pa = x[cst.a];
@@ -89,7 +91,7 @@ void DCL_FRAME_BODY(__global const DrapeClGarment* g, DCL_XS float4* x, __global
           if (!(len2 > 1e-18f)) continue;
           const float y = rsqrt(len2);
           const float c_len = fmax(len2 * y - cst.rest * g->tether_scale, 0.0f);
-          pa.xyz -= (pa.w * c_len * y * cst.inv_w) * d;
+          pa.xyz -= (pa.w * c_len * y * dcl_inv_w(cst.w_sum, alpha)) * d;
           x[cst.a] = pa;
         }
         barrier(CLK_LOCAL_MEM_FENCE | CLK_GLOBAL_MEM_FENCE);

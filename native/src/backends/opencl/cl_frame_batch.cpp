@@ -78,7 +78,7 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
   pin_targets_.clear();
   shapes_host_.clear();
   bounds_host_.clear();
-  std::vector<std::pair<uint64_t, uint64_t>>& layout = next_layout_;  // scratch, kept between frames
+  std::vector<uint64_t>& layout = next_layout_;  // scratch, kept between frames
   layout.clear();
   size_t particles = 0, pins = 0, constraints = 0, groups = 0;
   for (size_t i = 0; i < count; ++i) {
@@ -98,7 +98,7 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
     pin_targets_.insert(pin_targets_.end(), s.pin_target4_.begin(), s.pin_target4_.end());
     shapes_host_.insert(shapes_host_.end(), s.shapes_.begin(), s.shapes_.end());
     bounds_host_.insert(bounds_host_.end(), s.bounds_.begin(), s.bounds_.end());
-    layout.emplace_back(s.batch_id_, s.constraint_version_);
+    layout.push_back(s.batch_id_);
     if (i >= work_groups)
       plan_.setGarment(i, static_cast<uint32_t>(s.particleCount()), static_cast<uint32_t>(s.pin_index_.size()),
                        s.group_offsets_, s.distance_groups_, s.tether_groups_);
@@ -116,7 +116,8 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
             grow(bounds_.mem, bounds_.capacity, bounds_host_.size() * 16, ro) &&
             grow(stats_.mem, stats_.capacity, count * sizeof(DrapeClStats), rw) &&
             grow(work_.mem, work_.capacity, plan_.work().size() * 4, ro);
-  // Static data: again only when a member or its constraints (inv_w for a new h) changed. A
+  // Static data: again only when the members changed (the constraints are fixed per solver: a
+  // new h changes only the garment records' alpha). A
   // reallocated static buffer forgets its contents, so it forces the upload too.
   const size_t pin_index_cap = pin_index_.capacity, constraint_cap = constraints_.capacity,
                group_cap = groups_.capacity, mask_cap = masks_.capacity, triangle_cap = triangles_.capacity,

@@ -60,9 +60,9 @@ class ClFrameBatch {
   // run()'s members in table order: the one-work-group garments first (work-group g of the
   // frame kernel = table entry g), then the per-phase ones.
   std::vector<ClXpbdSolver*> members_;
-  // The members (solver id, constraint version) whose static data the device holds.
-  std::vector<std::pair<uint64_t, uint64_t>> layout_;
-  std::vector<std::pair<uint64_t, uint64_t>> next_layout_;  // run()'s scratch: this frame's members
+  // The members (solver ids) whose static data the device holds.
+  std::vector<uint64_t> layout_;
+  std::vector<uint64_t> next_layout_;  // run()'s scratch: this frame's members
   // Host staging of the last run (non-blocking uploads read them until the frame ends).
   std::vector<DrapeClGarment> table_;
   std::vector<DrapeClTransform> transforms_host_;  // the members' deferred rigid carries

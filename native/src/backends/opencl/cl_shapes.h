@@ -14,7 +14,7 @@
 namespace drape {
 
 static_assert(sizeof(DrapeClShape) == 24 * 16, "DrapeClShape layout differs from the kernels'");
-static_assert(sizeof(DrapeClGarment) == 9 * 16, "DrapeClGarment layout differs from the kernels'");
+static_assert(sizeof(DrapeClGarment) == 11 * 16, "DrapeClGarment layout differs from the kernels'");
 static_assert(sizeof(DrapeClConstraint) == 16, "DrapeClConstraint layout differs from the kernels'");
 static_assert(sizeof(DrapeClTransform) == 6 * 16, "DrapeClTransform layout differs from the kernels'");
 

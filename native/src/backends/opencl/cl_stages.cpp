@@ -123,7 +123,8 @@ bool clCollide(ClRuntime& rt, const std::vector<DrapeClShape>& shapes, const std
 }
 
 bool clProjectGroup(ClRuntime& rt, const std::vector<DrapeClConstraint>& constraints, uint32_t begin, uint32_t end,
-                    bool tether, float tether_scale, std::vector<DclF4>& x, std::string& err, ClStageTimes* times) {
+                    bool tether, float tether_scale, float alpha, std::vector<DclF4>& x, std::string& err,
+                    ClStageTimes* times) {
   if (begin > end || end > constraints.size()) {
     err = "clProjectGroup: bad range";
     return false;
@@ -138,6 +139,7 @@ bool clProjectGroup(ClRuntime& rt, const std::vector<DrapeClConstraint>& constra
   l.arg(3, static_cast<cl_uint>(end));
   l.arg(4, t);
   l.arg(5, tether_scale);
+  l.arg(6, alpha);
   l.run(end - begin);
   l.read(xb, x.data(), x.size() * 16);
   l.times(times);

@@ -26,9 +26,9 @@ bool clCollide(ClRuntime& rt, const std::vector<DrapeClShape>& shapes, const std
                ClStageTimes* times = nullptr);
 
 // One colour group: constraints [begin, end) of `constraints` projected on x (tether: one-sided
-// with `tether_scale`).
+// with `tether_scale`), each with inv_w = 1 / (w_sum + alpha), alpha = compliance / h^2.
 bool clProjectGroup(ClRuntime& rt, const std::vector<DrapeClConstraint>& constraints, uint32_t begin, uint32_t end,
-                    bool tether, float tether_scale, std::vector<DclF4>& x, std::string& err,
+                    bool tether, float tether_scale, float alpha, std::vector<DclF4>& x, std::string& err,
                     ClStageTimes* times = nullptr);
 
 // Area-weighted unit vertex normals of x for the triangle list `indices` (vertexNormals).

@@ -91,7 +91,6 @@ bool ClXpbdSolver::prepareFrame(float dt, int substeps) {
   const auto host0 = Clock::now();
   const float h = dt / static_cast<float>(substeps);
   const float inv_h2 = 1.0f / (h * h);
-  if (inv_h2 != inv_w_h2_) refreshInvW(inv_h2);
   const int count = static_cast<int>(motion_start_.size());
   const int stride = params_.collision_stride;
   if (count > 0) {
@@ -141,6 +140,13 @@ bool ClXpbdSolver::prepareFrame(float dt, int substeps) {
   g.static_friction = cp.static_friction > 0.0f ? std::min(cp.static_friction, 1e6f) : 0.0f;
   g.kinetic_friction = cp.kinetic_friction > 0.0f ? std::min(cp.kinetic_friction, 1e6f) : 0.0f;
   g.max_escape = cp.max_escape_m;
+  // alpha~ = compliance / h^2 per kind, as XpbdSolver forms it (compliance * inv_h2): the kernels
+  // add it to each constraint's static w_sum, so a new h costs nothing more than this record.
+  const float by_kind[3] = {p.stretch_compliance, p.shear_compliance, p.bend_compliance};
+  for (int slot = 0; slot < 3; ++slot) g.alpha[slot] = by_kind[kDistanceKindOrder[slot]] * inv_h2;
+  g.alpha[3] = p.tether_compliance * inv_h2;
+  g.kind_end[0] = kind_end_[0];
+  g.kind_end[1] = kind_end_[1];
   timings_.host_ns = std::chrono::duration<double, std::nano>(Clock::now() - host0).count();
   return true;
 }

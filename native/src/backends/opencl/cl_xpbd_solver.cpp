@@ -17,14 +17,13 @@ void release(cl_mem& m) {
   m = nullptr;
 }
 
-// Appends the colour groups of `c` (compliance per constraint) to the device lists.
-void appendGroups(const DistanceConstraints& c, float compliance, std::vector<DrapeClConstraint>& out,
-                  std::vector<float>& comp, std::vector<uint32_t>& offsets) {
+// Appends the colour groups of `c` to the device lists; w_sum = w_a + w_b (one-sided tethers:
+// w_a), the part of 1 / (w_a + w_b + alpha~) that does not change with h (DrapeClConstraint).
+void appendGroups(const DistanceConstraints& c, bool one_sided, const std::vector<float>& w,
+                  std::vector<DrapeClConstraint>& out, std::vector<uint32_t>& offsets) {
   for (size_t g = 0; g < c.colours(); ++g) {
-    for (uint32_t k = c.colour_offsets[g]; k < c.colour_offsets[g + 1]; ++k) {
-      out.push_back(DrapeClConstraint{c.a[k], c.b[k], c.rest[k], 0.0f});
-      comp.push_back(compliance);
-    }
+    for (uint32_t k = c.colour_offsets[g]; k < c.colour_offsets[g + 1]; ++k)
+      out.push_back(DrapeClConstraint{c.a[k], c.b[k], c.rest[k], w[c.a[k]] + (one_sided ? 0.0f : w[c.b[k]])});
     offsets.push_back(static_cast<uint32_t>(out.size()));
   }
 }
@@ -63,11 +62,13 @@ std::unique_ptr<ClXpbdSolver> ClXpbdSolver::create(std::shared_ptr<ClRuntime> ru
   s->group_offsets_.push_back(0);
   const GarmentTopology& t = s->topology_;
   const DistanceConstraints* kinds[3] = {&t.stretch, &t.shear, &t.bend};
-  for (uint8_t kind : kDistanceKindOrder)  // the CPU solver's order (xpbd_solver.h)
-    appendGroups(*kinds[kind], 0.0f, s->constraints_, s->compliance_, s->group_offsets_);
+  for (int slot = 0; slot < 3; ++slot) {  // the CPU solver's order (kDistanceKindOrder, xpbd_solver.h)
+    appendGroups(*kinds[kDistanceKindOrder[slot]], false, t.inverse_mass, s->constraints_, s->group_offsets_);
+    if (slot < 2) s->kind_end_[slot] = static_cast<uint32_t>(s->group_offsets_.size() - 1);
+  }
   s->distance_groups_ = static_cast<uint32_t>(s->group_offsets_.size() - 1);
   s->group_offsets_.push_back(static_cast<uint32_t>(s->constraints_.size()));
-  appendGroups(t.tether, 0.0f, s->constraints_, s->compliance_, s->group_offsets_);
+  appendGroups(t.tether, true, t.inverse_mass, s->constraints_, s->group_offsets_);
   s->tether_groups_ = static_cast<uint32_t>(s->group_offsets_.size()) - s->distance_groups_ - 2;
   std::string perr;
   if (!s->setParams(XpbdParams{}, perr) || !s->allocate(err)) {
@@ -204,29 +205,8 @@ bool ClXpbdSolver::pushPositions() {
 bool ClXpbdSolver::setParams(const XpbdParams& p, std::string& error) {
   XpbdSolver probe{GarmentTopology{}};  // the CPU solver's validation, message for message
   if (!probe.setParams(p, error)) return false;
-  params_ = p;
-  const float by_kind[3] = {p.stretch_compliance, p.shear_compliance, p.bend_compliance};
-  const GarmentTopology& t = topology_;
-  size_t k = 0;
-  const DistanceConstraints* kinds[3] = {&t.stretch, &t.shear, &t.bend};
-  for (uint8_t kind : kDistanceKindOrder)
-    for (size_t c = 0; c < kinds[kind]->a.size(); ++c) compliance_[k++] = by_kind[kind];
-  for (; k < compliance_.size(); ++k) compliance_[k] = p.tether_compliance;
-  inv_w_h2_ = -1.0f;  // recompute inv_w at the next step
+  params_ = p;  // the compliances reach the device as each frame's alpha~ (prepareFrame)
   return true;
-}
-
-void ClXpbdSolver::refreshInvW(float inv_h2) {
-  const size_t first_tether = group_offsets_[distance_groups_];
-  for (size_t k = 0; k < constraints_.size(); ++k) {
-    DrapeClConstraint& c = constraints_[k];
-    const float wb = k >= first_tether ? 0.0f : x_[c.b].w();
-    const float wsum = x_[c.a].w() + wb + compliance_[k] * inv_h2;
-    c.inv_w = wsum > 0.0f ? 1.0f / wsum : 0.0f;
-  }
-  inv_w_h2_ = inv_h2;
-  constraints_dirty_ = true;
-  ++constraint_version_;
 }
 
 bool ClXpbdSolver::setPinTargets(const Vec3* targets, size_t count, std::string& error) {

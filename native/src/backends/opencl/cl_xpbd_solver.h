@@ -114,18 +114,16 @@ class ClXpbdSolver {
   bool allocate(std::string& err);
   bool upload(cl_mem buffer, const void* data, size_t bytes, std::vector<cl_event>* events);
   bool uploadState();  // x_, v_ (and prev) to the device
-  void refreshInvW(float inv_h2);
 
   std::shared_ptr<ClRuntime> runtime_;
   GarmentTopology topology_;
   XpbdParams params_;
   std::vector<uint8_t> masks_, groups_;
-  std::vector<DrapeClConstraint> constraints_;  // distance groups then tether groups
-  std::vector<float> compliance_;                // per constraint
+  std::vector<DrapeClConstraint> constraints_;  // distance groups then tether groups (static)
   std::vector<uint32_t> group_offsets_;          // distance groups + 1, then tether groups + 1
   uint32_t distance_groups_ = 0, tether_groups_ = 0;
-  float inv_w_h2_ = -1.0f;
-  bool constraints_dirty_ = true;
+  uint32_t kind_end_[2] = {0, 0};  // distance group index where the 1st / 2nd kind ends (DrapeClGarment)
+  bool constraints_dirty_ = true;  // not on the device yet
 
   std::vector<Eigen::Vector4f> x_;
   std::vector<cl_event> writes_, runs_, reads_;   // stepDevice scratch (events of one frame)
@@ -143,7 +141,6 @@ class ClXpbdSolver {
   friend class ClFrameBatch;
   DrapeClGarment frame_g_{};         // the prepared frame's record (offsets: this garment alone)
   bool prepared_ = false;
-  uint64_t constraint_version_ = 0;  // bumped whenever constraints_ change (inv_w for a new h)
   uint64_t batch_id_ = 0;            // unique per solver in the process (a batch's layout key)
 
   // transform()'s device half, deferred to the next device use (or done for a whole batch by
