@@ -442,6 +442,10 @@ int run(int argc, char** argv) {
     st.cloth_ms.push_back(gs.step_ms);
     st.integrate_ms.push_back(gs.integrate_ms);
     st.collide_ms.push_back(gs.collide_ms);
+    st.device_upload_ms.push_back(gs.device_upload_ms);
+    st.device_kernel_ms.push_back(gs.device_kernel_ms);
+    st.device_readback_ms.push_back(gs.device_readback_ms);
+    st.device_host_ms.push_back(gs.device_host_ms);
     st.contacts.push_back(gs.contacts);
     st.substeps.push_back(gs.substeps);
     st.teleport_resets += gs.teleport_reset ? 1u : 0u;

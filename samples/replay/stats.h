@@ -75,6 +75,8 @@ struct ReplayStats {
   uint32_t refits = 0;             // drape_garment_stats.refits after the last step
   // Per stepped frame (drape_garment_get_stats after the step).
   std::vector<double> cloth_ms, integrate_ms, collide_ms, contacts, substeps;
+  // OpenCL backend: the device frame's split (drape_garment_stats.device_*; 0 on the CPU).
+  std::vector<double> device_upload_ms, device_kernel_ms, device_readback_ms, device_host_ms;
   // Stretch of every structural edge of every stepped frame, from the positions read back.
   StretchAccumulator stretch;
   // Per measured frame (drape_garment_measure, --measure-every).

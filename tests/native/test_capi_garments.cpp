@@ -131,6 +131,40 @@ TEST(CApiGarments, TemplateGarmentFollowsTheBody) {
   EXPECT_LT(a.p99_stretch, 0.10f);
   EXPECT_GE(a.max_stretch, a.p99_stretch);
   EXPECT_EQ(s.refits, 0u);  // calibrated at 30 frames; the default DRAPE_GARMENT_FIT_SHAPE keeps the cut
+  EXPECT_EQ(s.struct_size, sizeof(s));
+  // The CPU backend has no device frames.
+  EXPECT_EQ(s.device_upload_ms, 0.0);
+  EXPECT_EQ(s.device_kernel_ms, 0.0);
+  EXPECT_EQ(s.device_readback_ms, 0.0);
+  EXPECT_EQ(s.device_host_ms, 0.0);
+}
+
+// drape_garment_stats grew the device_* fields; a caller built against the first version (72
+// bytes) still gets its fields and nothing written past them; below that, an error.
+TEST(CApiGarments, StatsOfTheFirstStructVersionAreStillFilled) {
+  ContextPtr ctx = makeContext();
+  drape_garment* g = addTShirt(ctx.get());
+  ASSERT_NE(g, nullptr);
+  for (int i = 0; i < 3; ++i) ASSERT_OK(pushAndStep(ctx.get(), i));
+  drape_garment_stats full;
+  full.struct_size = sizeof(full);
+  ASSERT_OK(drape_garment_get_stats(g, &full));
+  alignas(drape_garment_stats) unsigned char buf[sizeof(drape_garment_stats)];
+  std::memset(buf, 0xAB, sizeof(buf));
+  const uint32_t v1 = 72;
+  std::memcpy(buf, &v1, sizeof(v1));
+  ASSERT_OK(drape_garment_get_stats(g, reinterpret_cast<drape_garment_stats*>(buf)));
+  EXPECT_EQ(std::memcmp(buf + sizeof(uint32_t), reinterpret_cast<const unsigned char*>(&full) + sizeof(uint32_t), v1 - sizeof(uint32_t)), 0);
+  uint32_t written = 0;
+  std::memcpy(&written, buf, sizeof(written));
+  EXPECT_EQ(written, v1);
+  for (size_t k = v1; k < sizeof(buf); ++k) ASSERT_EQ(buf[k], 0xAB) << "byte " << k << " written past struct_size";
+  std::memset(buf, 0xAB, sizeof(buf));
+  const uint32_t too_small = v1 - 4;
+  std::memcpy(buf, &too_small, sizeof(too_small));
+  EXPECT_FAILS(DRAPE_ERROR_INVALID_ARGUMENT, "drape_garment_stats.struct_size",
+               drape_garment_get_stats(g, reinterpret_cast<drape_garment_stats*>(buf)));
+  for (size_t k = sizeof(uint32_t); k < sizeof(buf); ++k) ASSERT_EQ(buf[k], 0xAB) << "byte " << k << " written on error";
 }
 
 TEST(CApiGarments, SameInputGivesBitIdenticalGarments) {

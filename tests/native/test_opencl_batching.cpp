@@ -182,6 +182,34 @@ TEST(OpenClBatching, GarmentsOfOneContextMatchOneByOneBitForBit) {
   EXPECT_STREQ(backendInfo(batched.ctx.get()).fallback_reason, "");
 }
 
+// drape_garment_stats' device_* split (the queue's profiling events): a garment stepped on its
+// own reports its uploads, kernels and readback, and their sum fits inside its step's wall time;
+// garments batched together report zeros (a batch is timed as a whole), as the CPU backend does.
+TEST(OpenClBatching, DeviceTimesOfAGarmentAloneAndZeroInABatch) {
+  DRAPE_LOAD_TAKE(take, 4);
+  World alone = makeWorld({sized(600)}, DRAPE_BACKEND_OPENCL);
+  DRAPE_REQUIRE_DEVICE_WORLD(alone);
+  World two = makeWorld({sized(600), sized(700)}, DRAPE_BACKEND_OPENCL);
+  ASSERT_EQ(backendInfo(two.ctx.get()).opencl_garments, 2u);
+  runTake({&alone, &two}, take, false);
+  drape_garment_stats s;
+  s.struct_size = sizeof(s);
+  ASSERT_EQ(drape_garment_get_stats(alone.garments[0], &s), DRAPE_OK) << lastError();
+  EXPECT_GT(s.device_kernel_ms, 0.0);
+  EXPECT_GT(s.device_readback_ms, 0.0);
+  EXPECT_GT(s.device_upload_ms, 0.0);
+  EXPECT_GE(s.device_host_ms, 0.0);
+  const double sum = s.device_upload_ms + s.device_kernel_ms + s.device_readback_ms + s.device_host_ms;
+  EXPECT_LE(sum, s.step_ms * 1.01 + 0.01) << "device split " << sum << " ms in a " << s.step_ms << " ms step";
+  EXPECT_EQ(s.collide_ms, 0.0);  // collision runs inside the device frame
+  for (drape_garment* g : two.garments) {
+    ASSERT_EQ(drape_garment_get_stats(g, &s), DRAPE_OK) << lastError();
+    EXPECT_GT(s.step_ms, 0.0);
+    EXPECT_EQ(s.device_kernel_ms, 0.0);
+    EXPECT_EQ(s.device_upload_ms + s.device_readback_ms + s.device_host_ms, 0.0);
+  }
+}
+
 TEST(OpenClBatching, ContextsSteppedTogetherMatchSeparateStepsBitForBit) {
   DRAPE_LOAD_TAKE(take, 12);
   World a = makeWorld({sized(600)}, DRAPE_BACKEND_OPENCL), b = makeWorld({sized(500), sized(900)}, DRAPE_BACKEND_OPENCL);

@@ -647,7 +647,7 @@ namespace Drape
         }
     }
 
-    /// <summary>drape_garment_stats (72 bytes): what the garment's last step did.</summary>
+    /// <summary>drape_garment_stats (104 bytes): what the garment's last step did.</summary>
     [StructLayout(LayoutKind.Sequential)]
     public struct GarmentStats
     {
@@ -687,6 +687,17 @@ namespace Drape
         public double CollideMs;
         /// <summary>integrate_ms: the rest (integration and constraints).</summary>
         public double IntegrateMs;
+        /// <summary>device_upload_ms: OpenCL backend, host to device writes of the last step's device
+        /// frames (the queue's profiling events). The four device_* fields are 0 on the CPU backend and
+        /// when the frame ran batched with other garments' (a batch is timed as a whole).</summary>
+        public double DeviceUploadMs;
+        /// <summary>device_kernel_ms: the first launch's start to the last one's end.</summary>
+        public double DeviceKernelMs;
+        /// <summary>device_readback_ms: positions (and normals when read) back to the host.</summary>
+        public double DeviceReadbackMs;
+        /// <summary>device_host_ms: the host packing the frame before the uploads. What
+        /// <see cref="IntegrateMs"/> holds beyond the four is the host enqueueing and waiting.</summary>
+        public double DeviceHostMs;
 
         /// <summary><see cref="TeleportReset"/> as a bool.</summary>
         public bool IsTeleportReset => TeleportReset != 0;

@@ -574,9 +574,11 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_view_positions(drape_garment* ga
                                                                const float** out_xyzw,
                                                                uint32_t* out_vertex_count);
 
-/* What the last step did. */
+/* What the last step did. struct_size 72 (the first version, without the device_* fields) is
+ * still accepted: then only its first 72 bytes are written. */
 typedef struct drape_garment_stats {
-  uint32_t struct_size;     /* caller sets sizeof(drape_garment_stats) */
+  uint32_t struct_size;     /* caller sets sizeof(drape_garment_stats); the library writes back
+                               how many bytes it filled */
   uint32_t particles;
   uint32_t attached;        /* particles pinned to body rings */
   uint32_t substeps;        /* in the last step (blend-in frames included) */
@@ -596,6 +598,15 @@ typedef struct drape_garment_stats {
                                collision runs inside the device frame (docs/opencl.md) */
   double integrate_ms;      /* the rest: integration and constraints; on OpenCL the whole
                                device frame (its transfers and the wait for it included) */
+  /* OpenCL backend: where the last step's device frames went, from the queue's profiling events
+   * (summed over the step's frames). What integrate_ms holds beyond their sum is the host
+   * enqueueing the launches and waiting for them. 0 on the CPU backend, and when the frame ran
+   * batched with other garments' (drape_step_contexts, or several device garments in one
+   * context): a batch is timed as a whole, not per garment (docs/opencl.md). */
+  double device_upload_ms;   /* host -> device writes: the garment record, pins, ellipsoids */
+  double device_kernel_ms;   /* the first launch's start to the last one's end */
+  double device_readback_ms; /* positions (and normals when read) back to the host */
+  double device_host_ms;     /* the host packing the frame (collision spans) before the uploads */
 } drape_garment_stats;
 
 DRAPE_API drape_result DRAPE_CALL drape_garment_get_stats(drape_garment* garment,

@@ -5,6 +5,8 @@
 #include "cloth/garment_obj.h"
 #include "cloth/garment_templates.h"
 
+#include <algorithm>
+#include <cstddef>
 #include <cstring>
 #include <memory>
 #include <sstream>
@@ -544,7 +546,10 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_get_stats(drape_garment* handle,
   return guarded("drape_garment_get_stats", [&]() -> drape_result {
     DRAPE_CHECK_GARMENT("drape_garment_get_stats", handle);
     if (!out) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_garment_get_stats: out_stats is NULL");
-    if (drape_result r = checkStructSize(out->struct_size, sizeof(drape_garment_stats), "drape_garment_stats")) return r;
+    // The first version of the struct (72 bytes, no device_* fields) is still accepted: the
+    // caller's struct_size says how many bytes are its own.
+    constexpr uint32_t kFirstVersionSize = 72;
+    if (drape_result r = checkStructSize(out->struct_size, kFirstVersionSize, "drape_garment_stats")) return r;
     const drape::GarmentStepStats& s = garment->lastStep();
     drape_garment_stats o;
     std::memset(&o, 0, sizeof(o));
@@ -563,7 +568,12 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_get_stats(drape_garment* handle,
     o.step_ms = s.total_ms;
     o.collide_ms = s.collide_ms;
     o.integrate_ms = s.total_ms - s.collide_ms;
-    *out = o;
+    o.device_upload_ms = s.device.upload_ms;
+    o.device_kernel_ms = s.device.kernel_ms;
+    o.device_readback_ms = s.device.readback_ms;
+    o.device_host_ms = s.device.host_ms;
+    o.struct_size = std::min<uint32_t>(out->struct_size, sizeof(o));
+    std::memcpy(out, &o, o.struct_size);
     return DRAPE_OK;
   });
 }
@@ -594,6 +604,7 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_measure(drape_garment* handle, d
 static_assert(sizeof(drape_garment_desc) == 24, "drape_garment_desc layout");
 static_assert(sizeof(drape_garment_template) == 24, "drape_garment_template layout");
 static_assert(sizeof(drape_mesh_fit) == 48, "drape_mesh_fit layout");
-static_assert(sizeof(drape_garment_stats) == 72, "drape_garment_stats layout");
+static_assert(sizeof(drape_garment_stats) == 104, "drape_garment_stats layout");
+static_assert(offsetof(drape_garment_stats, device_upload_ms) == 72, "drape_garment_stats: version 1 ends at 72");
 static_assert(sizeof(drape_garment_accuracy) == 32, "drape_garment_accuracy layout");
 static_assert(sizeof(drape_cloth_params) == 128, "drape_cloth_params layout");

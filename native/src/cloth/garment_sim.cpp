@@ -430,6 +430,7 @@ void GarmentSim::runFrame(const std::vector<Ellipsoid>& start, const std::vector
 void GarmentSim::addFrameStats(int n) {
   last_.substeps += n;
   last_.collide_ms += solver_->collideMs();
+  last_.device += solver_->deviceTimes();
   const CollisionStats c = solver_->collision();
   last_.collision.tests += c.tests;
   last_.collision.contacts += c.contacts;

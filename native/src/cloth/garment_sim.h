@@ -66,11 +66,27 @@ struct GarmentSimParams {
 // Empty string when valid, else what is wrong.
 std::string validate(const GarmentSimParams& p);
 
+// Where a device frame's time went, from the OpenCL queue's profiling events (docs/opencl.md):
+// uploads, the kernels (first launch's start to the last one's end), the readback, and the host's
+// packing of the frame. What the step's wall time holds beyond their sum is the host enqueueing
+// the launches and waiting for them.
+struct DeviceFrameTimes {
+  double upload_ms = 0.0, kernel_ms = 0.0, readback_ms = 0.0, host_ms = 0.0;
+  DeviceFrameTimes& operator+=(const DeviceFrameTimes& o) {
+    upload_ms += o.upload_ms;
+    kernel_ms += o.kernel_ms;
+    readback_ms += o.readback_ms;
+    host_ms += o.host_ms;
+    return *this;
+  }
+};
+
 struct GarmentStepStats {
   int substeps = 0;
   int blend_frames = 0;          // extra frames run to settle on a new pose (first frame, teleport)
   double total_ms = 0.0;         // wall time of the step
   double collide_ms = 0.0;       // of which in the ellipsoid collision
+  DeviceFrameTimes device;       // a device solver's frames run on their own, summed (else 0)
   CollisionStats collision;      // summed over the substeps
   bool teleport_reset = false;
   bool nan_reset = false;

@@ -31,6 +31,10 @@ struct GarmentSim::Solver {
   virtual const Eigen::Vector4f* deviceNormals() { return nullptr; }
   virtual CollisionStats collision() const = 0;
   virtual double collideMs() const = 0;
+  // A device solver's split of its last frame when that frame ran on its own; zero for the CPU
+  // solvers and for a frame that ran batched with other garments' (timed as a whole, not per
+  // garment).
+  virtual DeviceFrameTimes deviceTimes() const { return {}; }
   // Backends (docs/opencl.md): which one runs the step, and for a device solver whether its
   // device failed (the garment then goes back to the CPU with `error` as the reason).
   virtual GarmentBackend backend() const { return GarmentBackend::Cpu; }

@@ -24,6 +24,7 @@ struct ClXpbdFace final : GarmentSim::Solver {
   }
   void step(float dt, int substeps) override {
     flush();
+    timed = true;
     // A device failure leaves the last good state; the context then moves the garment to the CPU.
     if (!s->step(dt, substeps) && !s->lastError().empty()) {
       failed = true;
@@ -38,6 +39,7 @@ struct ClXpbdFace final : GarmentSim::Solver {
   // The staged frame alone (runStagedClFrames batches the others).
   void runStaged() {
     staged = false;
+    timed = true;
     if (!s->runPreparedFrame() && !s->lastError().empty()) fail(s->lastError());
   }
   void fail(const std::string& why) {
@@ -66,6 +68,11 @@ struct ClXpbdFace final : GarmentSim::Solver {
   // Collision runs inside the frame kernel with the rest of the step: no separate time. 0, so the
   // stats' integrate_ms (step minus collide) holds the whole device frame (docs/opencl.md, drape.h).
   double collideMs() const override { return 0.0; }
+  DeviceFrameTimes deviceTimes() const override {
+    if (!timed) return {};
+    const ClStepTimings& t = s->lastTimings();
+    return DeviceFrameTimes{t.upload_ns * 1e-6, t.kernel_ns * 1e-6, t.readback_ns * 1e-6, t.host_ns * 1e-6};
+  }
   GarmentBackend backend() const override { return GarmentBackend::OpenCl; }
   bool deviceFailed(std::string* err) const override {
     if (failed && err) *err = error;
@@ -82,6 +89,7 @@ struct ClXpbdFace final : GarmentSim::Solver {
 
   std::unique_ptr<ClXpbdSolver> s;
   bool dirty = false, failed = false, staged = false;
+  bool timed = false;  // the last frame ran alone (step, runStaged): lastTimings() is its split
   std::string error;
 };
 
@@ -130,6 +138,7 @@ size_t runStagedClFrames(const std::vector<GarmentSim*>& garments) {
     const bool ok = rt->frameBatch().run(solvers, err);
     for (ClXpbdFace* f : together) {
       f->staged = false;
+      f->timed = false;  // a batch's frame is timed as a whole, not per garment
       if (!ok) f->fail(err);
     }
     if (ok) batched += together.size();
