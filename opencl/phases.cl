@@ -128,6 +128,36 @@ __kernel void drape_phase_project(__global const DrapeClGarment* table, uint cou
                   dcl_group_alpha(g, group, tether));
 }
 
+/* Consecutive colour groups (rows first_row .. first_row + rows - 1) small enough for one
+ * work-group - at most DRAPE_CL_WORK_GROUP items across the table each - in one launch of one
+ * work-group: row after row with a barrier between them, so each row sees the last one's writes
+ * as separate launches would, and each constraint runs the same arithmetic in the same order (the
+ * same bits). A garment template's underarm vertex is a fan of up to ~36 edges at 32 000
+ * particles, so greedy colouring gives its stretch and bend kinds ~35 colours each, most of them
+ * a few constraints of that fan: launched one by one they tripled the launches of a substep. */
+__kernel __attribute__((reqd_work_group_size(DRAPE_CL_WORK_GROUP, 1, 1)))
+void drape_phase_project_rows(__global const DrapeClGarment* table, uint count, __global const uint* work,
+                              __global float4* x, __global const DrapeClConstraint* constraints,
+                              __global const uint* groups, uint first_row, uint rows, uint distance_rows,
+                              int substep, int iteration) {
+  const uint lid = get_local_id(0);
+  for (uint r = first_row; r < first_row + rows; ++r) {
+    __global const uint* start = work + r * (count + 1u);
+    const uint c = r - 2u;
+    const uint tether = c >= distance_rows ? 1u : 0u;
+    const uint group = tether ? c - distance_rows : c;
+    for (uint i = lid; i < start[count]; i += DRAPE_CL_WORK_GROUP) {
+      const uint gi = dcl_owner(start, count, i);
+      __global const DrapeClGarment* g = table + gi;
+      if (substep >= g->substeps || iteration >= g->iterations) continue;
+      const uint first = groups[(tether ? g->tether_group_offset : g->distance_group_offset) + group];
+      dcl_project_one(x + g->particle_offset, constraints[first + i - start[gi]], tether, g->tether_scale,
+                      dcl_group_alpha(g, group, tether));
+    }
+    barrier(CLK_GLOBAL_MEM_FENCE);
+  }
+}
+
 /* Collision against the substep's span when the span ends here, then the velocity update.
  * Counters: one atomic per work-item that found something, into its garment's entry. */
 __kernel void drape_phase_collide_velocity(__global const DrapeClGarment* table, uint count,

@@ -18,7 +18,8 @@ export OCL_ICD_VENDORS=/tmp/icd
 [[ -d .gpu/shared/data ]] && export DRAPE_SHARED_DATA="$PWD/.gpu/shared/data"
 run() { local v="$1"; shift; LD_LIBRARY_PATH="$PWD/$v/lib" "$v/bin/$@"; }
 median() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); s=d['stages_ms']; g=d['garment']
-print(f\"frame {s['frame']:.3f} ms, cloth {s['cloth']:.3f}; {d['backend']} {d.get('device') or ''}; p99 stretch {g['p99_stretch']:.4f}, contacts {g['contacts']}, inside {g['proxy_inside']}\")" "$1"; }
+k = f\", kernels {s['device']['kernel']:.3f}\" if 'device' in s else ''
+print(f\"frame {s['frame']:.3f} ms, cloth {s['cloth']:.3f}{k}; {d['backend']} {d.get('device') or ''}; p99 stretch {g['p99_stretch']:.4f}, contacts {g['contacts']}, inside {g['proxy_inside']}\")" "$1"; }
 
 timeout 150 bash -c "$(declare -f run); run .gpu drape_tests --gtest_filter='*OpenCl*:*Backend*:*Batch*:*StepContexts*' --gtest_brief=1" 2>&1 |
   grep -vE '^(1 (error|warning)|2 warnings)' | tail -25 | tee "$out/tests.txt"

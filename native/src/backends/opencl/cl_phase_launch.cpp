@@ -37,6 +37,7 @@ void ClPhasePlan::setGarment(size_t i, uint32_t particles, uint32_t pins, const 
 void ClPhasePlan::finish() {
   const size_t rows = 2 + max_distance_ + max_tether_, stride = garments_ + 1;
   work_.assign(rows * stride, 0u);
+  max_items_.assign(rows, 0u);
   auto count = [&](size_t row, size_t g) -> uint32_t {
     if (row == 0) return particles_[g];
     if (row == 1) return pins_[g];
@@ -50,13 +51,14 @@ void ClPhasePlan::finish() {
     for (size_t g = 0; g < garments_; ++g) {
       work_[row * stride + g] = sum;
       sum += count(row, g);
+      max_items_[row] = std::max(max_items_[row], count(row, g));
     }
     work_[row * stride + garments_] = sum;
   }
 }
 
 ClPhaseKernels::~ClPhaseKernels() {
-  for (cl_kernel k : {clear_stats_, pin_start_, predict_, pins_, project_, collide_velocity_})
+  for (cl_kernel k : {clear_stats_, pin_start_, predict_, pins_, project_, project_rows_, collide_velocity_})
     if (k) clReleaseKernel(k);
 }
 
@@ -65,7 +67,8 @@ bool ClPhaseKernels::create(cl_program program, std::string& err) {
   const std::pair<cl_kernel*, const char*> kernels[] = {
       {&clear_stats_, "drape_phase_clear_stats"}, {&pin_start_, "drape_phase_pin_start"},
       {&predict_, "drape_phase_predict"},         {&pins_, "drape_phase_pins"},
-      {&project_, "drape_phase_project"},         {&collide_velocity_, "drape_phase_collide_velocity"}};
+      {&project_, "drape_phase_project"},         {&project_rows_, "drape_phase_project_rows"},
+      {&collide_velocity_, "drape_phase_collide_velocity"}};
   cl_int rc = CL_SUCCESS;
   for (const auto& k : kernels) {
     *k.first = clCreateKernel(program, k.second, &rc);
@@ -92,7 +95,7 @@ cl_int ClPhaseKernels::enqueue(ClRuntime& runtime, const ClPhaseBuffers& b, cons
     if (rc == CL_SUCCESS) rc = clSetKernelArg(k, i, sizeof(v), &v);
   };
   // The table's common head: table, count, work.
-  for (cl_kernel k : {pin_start_, predict_, pins_, project_, collide_velocity_}) {
+  for (cl_kernel k : {pin_start_, predict_, pins_, project_, project_rows_, collide_velocity_}) {
     arg(k, 0, b.table);
     arg(k, 1, count);
     arg(k, 2, b.work);
@@ -102,6 +105,7 @@ cl_int ClPhaseKernels::enqueue(ClRuntime& runtime, const ClPhaseBuffers& b, cons
   arg(predict_, 3, b.x), arg(predict_, 4, b.prev), arg(predict_, 5, b.v), arg(predict_, 6, b.span_start);
   arg(pins_, 3, b.x), arg(pins_, 4, b.pin_start), arg(pins_, 5, b.pin_index), arg(pins_, 6, b.pin_target);
   arg(project_, 3, b.x), arg(project_, 4, b.constraints), arg(project_, 5, b.groups);
+  arg(project_rows_, 3, b.x), arg(project_rows_, 4, b.constraints), arg(project_rows_, 5, b.groups);
   arg(collide_velocity_, 3, b.x), arg(collide_velocity_, 4, b.prev), arg(collide_velocity_, 5, b.v),
       arg(collide_velocity_, 6, b.span_start), arg(collide_velocity_, 7, b.masks), arg(collide_velocity_, 8, b.shapes),
       arg(collide_velocity_, 9, b.bounds), arg(collide_velocity_, 10, b.stats);
@@ -125,6 +129,10 @@ cl_int ClPhaseKernels::enqueue(ClRuntime& runtime, const ClPhaseBuffers& b, cons
   launch(clear_stats_, count, false);
   launch(pin_start_, plan.items(1), false);
   const uint32_t distance = plan.distanceGroups(), tether = plan.tetherGroups();
+  arg(project_rows_, 8, static_cast<cl_uint>(distance));
+  // Runs of consecutive small colour groups (rows 2 + c): one launch of one work-group each.
+  const size_t wg = runtime.workGroup();
+  auto small = [&](uint32_t c) { return plan.maxItems(2 + c) <= wg; };
   for (int s = 0; s < substeps; ++s) {
     const cl_int sub = s;
     arg(predict_, 7, sub);
@@ -132,9 +140,24 @@ cl_int ClPhaseKernels::enqueue(ClRuntime& runtime, const ClPhaseBuffers& b, cons
     arg(pins_, 7, sub);
     launch(pins_, plan.items(1), false);
     arg(project_, 9, sub);
+    arg(project_rows_, 9, sub);
     for (int it = 0; it < iterations; ++it) {
       arg(project_, 10, static_cast<cl_int>(it));
+      arg(project_rows_, 10, static_cast<cl_int>(it));
       for (uint32_t c = 0; c < distance + tether; ++c) {
+        uint32_t run = 0;
+        while (c + run < distance + tether && small(c + run)) ++run;
+        if (run >= 2) {
+          arg(project_rows_, 6, static_cast<cl_uint>(2 + c));
+          arg(project_rows_, 7, static_cast<cl_uint>(run));
+          if (rc == CL_SUCCESS) {
+            cl_event* e = (first && !*first) ? first : nullptr;
+            rc = clEnqueueNDRangeKernel(q, project_rows_, 1, nullptr, &wg, &wg, 0, nullptr, e);
+            runtime.countLaunches();
+          }
+          c += run - 1;
+          continue;
+        }
         const bool is_tether = c >= distance;
         arg(project_, 6, static_cast<cl_uint>(2 + c));
         arg(project_, 7, static_cast<cl_uint>(is_tether ? c - distance : c));

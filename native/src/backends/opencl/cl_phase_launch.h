@@ -32,6 +32,9 @@ class ClPhasePlan {
   uint32_t tetherGroups() const { return max_tether_; }
   const std::vector<uint32_t>& work() const { return work_; }
   uint32_t items(size_t row) const { return work_[row * (garments_ + 1) + garments_]; }
+  // The largest one garment's item count in the row (whether a row is "small" does not depend on
+  // how many garments share the launch: the launches per frame do not grow with them).
+  uint32_t maxItems(size_t row) const { return max_items_[row]; }
 
  private:
   size_t garments_ = 0;
@@ -40,7 +43,7 @@ class ClPhasePlan {
   // Per garment: particles, pins, then its group sizes (distance, tether) as counts.
   std::vector<std::vector<uint32_t>> distance_, tether_;
   std::vector<uint32_t> particles_, pins_;
-  std::vector<uint32_t> work_;
+  std::vector<uint32_t> work_, max_items_;
 };
 
 // The device buffers one phase frame reads and writes (the table's layout: offsets into them).
@@ -59,7 +62,8 @@ class ClPhaseKernels {
 
   bool create(cl_program program, std::string& err);
   // Queues the frame of every per-phase garment of `table` (plan.garments() entries, the same
-  // as on the device in b.table), without waiting. Substeps and passes run up to the largest
+  // as on the device in b.table), without waiting. Consecutive colour groups of at most a
+  // work-group's items each run in one launch of one work-group (drape_phase_project_rows). Substeps and passes run up to the largest
   // of those garments'. first/last (optional): events of the first and the last launch (the
   // kernel time), which the caller releases. CL_SUCCESS or the failing call's code.
   cl_int enqueue(ClRuntime& runtime, const ClPhaseBuffers& b, const ClPhasePlan& plan,
@@ -67,7 +71,7 @@ class ClPhaseKernels {
 
  private:
   cl_kernel clear_stats_ = nullptr, pin_start_ = nullptr, predict_ = nullptr, pins_ = nullptr, project_ = nullptr,
-            collide_velocity_ = nullptr;
+            project_rows_ = nullptr, collide_velocity_ = nullptr;
 };
 
 }  // namespace drape
