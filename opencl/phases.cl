@@ -129,8 +129,8 @@ __kernel void drape_phase_project(__global const DrapeClGarment* table, uint cou
 }
 
 /* Consecutive colour groups (rows first_row .. first_row + rows - 1) small enough for one
- * work-group - at most DRAPE_CL_WORK_GROUP items across the table each - in one launch of one
- * work-group: row after row with a barrier between them, so each row sees the last one's writes
+ * work-group - at most DRAPE_CL_WORK_GROUP items per garment each (the host's choice; the loop
+ * below takes any count) - in one launch of one work-group: row after row with a barrier between them, so each row sees the last one's writes
  * as separate launches would, and each constraint runs the same arithmetic in the same order (the
  * same bits). A garment template's underarm vertex is a fan of up to ~36 edges at 32 000
  * particles, so greedy colouring gives its stretch and bend kinds ~35 colours each, most of them

@@ -546,9 +546,9 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_get_stats(drape_garment* handle,
   return guarded("drape_garment_get_stats", [&]() -> drape_result {
     DRAPE_CHECK_GARMENT("drape_garment_get_stats", handle);
     if (!out) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_garment_get_stats: out_stats is NULL");
-    // The first version of the struct (72 bytes, no device_* fields) is still accepted: the
+    // The first version of the struct (up to device_upload_ms: 72 bytes) is still accepted: the
     // caller's struct_size says how many bytes are its own.
-    constexpr uint32_t kFirstVersionSize = 72;
+    constexpr uint32_t kFirstVersionSize = offsetof(drape_garment_stats, device_upload_ms);
     if (drape_result r = checkStructSize(out->struct_size, kFirstVersionSize, "drape_garment_stats")) return r;
     const drape::GarmentStepStats& s = garment->lastStep();
     drape_garment_stats o;
@@ -605,6 +605,6 @@ static_assert(sizeof(drape_garment_desc) == 24, "drape_garment_desc layout");
 static_assert(sizeof(drape_garment_template) == 24, "drape_garment_template layout");
 static_assert(sizeof(drape_mesh_fit) == 48, "drape_mesh_fit layout");
 static_assert(sizeof(drape_garment_stats) == 104, "drape_garment_stats layout");
-static_assert(offsetof(drape_garment_stats, device_upload_ms) == 72, "drape_garment_stats: version 1 ends at 72");
+static_assert(offsetof(drape_garment_stats, device_upload_ms) == 72, "drape_garment_stats: the first version's 72 bytes moved");
 static_assert(sizeof(drape_garment_accuracy) == 32, "drape_garment_accuracy layout");
 static_assert(sizeof(drape_cloth_params) == 128, "drape_cloth_params layout");

@@ -117,8 +117,8 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
             grow(stats_.mem, stats_.capacity, count * sizeof(DrapeClStats), rw) &&
             grow(work_.mem, work_.capacity, plan_.work().size() * 4, ro);
   // Static data: again only when the members changed (the constraints are fixed per solver: a
-  // new h changes only the garment records' alpha). A
-  // reallocated static buffer forgets its contents, so it forces the upload too.
+  // new h changes only the garment records' alpha). A reallocated static buffer forgets its
+  // contents, so it forces the upload too.
   const size_t pin_index_cap = pin_index_.capacity, constraint_cap = constraints_.capacity,
                group_cap = groups_.capacity, mask_cap = masks_.capacity, triangle_cap = triangles_.capacity,
                face_offset_cap = face_offsets_.capacity, vertex_face_cap = vertex_faces_.capacity;

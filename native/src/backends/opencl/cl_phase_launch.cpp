@@ -117,11 +117,13 @@ cl_int ClPhaseKernels::enqueue(ClRuntime& runtime, const ClPhaseBuffers& b, cons
     substeps = std::max(substeps, table[g].substeps);
     iterations = std::max(iterations, table[g].iterations);
   }
-  auto launch = [&](cl_kernel k, size_t items, bool is_last) {
+  // One work-item per item, rounded up to 64; or, with `one_group`, a single work-group.
+  const size_t wg = runtime.workGroup();
+  auto launch = [&](cl_kernel k, size_t items, bool is_last, bool one_group = false) {
     if (rc != CL_SUCCESS || items == 0) return;
-    const size_t global = (items + 63) / 64 * 64;
+    const size_t global = one_group ? wg : (items + 63) / 64 * 64;
     cl_event* e = (first && !*first) ? first : (is_last ? last : nullptr);
-    rc = clEnqueueNDRangeKernel(q, k, 1, nullptr, &global, nullptr, 0, nullptr, e);
+    rc = clEnqueueNDRangeKernel(q, k, 1, nullptr, &global, one_group ? &wg : nullptr, 0, nullptr, e);
     runtime.countLaunches();
   };
   if (first) *first = nullptr;
@@ -130,9 +132,16 @@ cl_int ClPhaseKernels::enqueue(ClRuntime& runtime, const ClPhaseBuffers& b, cons
   launch(pin_start_, plan.items(1), false);
   const uint32_t distance = plan.distanceGroups(), tether = plan.tetherGroups();
   arg(project_rows_, 8, static_cast<cl_uint>(distance));
-  // Runs of consecutive small colour groups (rows 2 + c): one launch of one work-group each.
-  const size_t wg = runtime.workGroup();
-  auto small = [&](uint32_t c) { return plan.maxItems(2 + c) <= wg; };
+  // The colour groups' launches, the same every pass and substep: (first group, count), a count
+  // above 1 a run of consecutive small groups (rows 2 + c) for one launch of one work-group.
+  group_runs_.clear();
+  for (uint32_t c = 0; c < distance + tether;) {
+    uint32_t run = 0;
+    while (c + run < distance + tether && plan.maxItems(2 + c + run) <= wg) ++run;
+    run = run >= 2 ? run : 1;
+    group_runs_.emplace_back(c, run);
+    c += run;
+  }
   for (int s = 0; s < substeps; ++s) {
     const cl_int sub = s;
     arg(predict_, 7, sub);
@@ -144,18 +153,11 @@ cl_int ClPhaseKernels::enqueue(ClRuntime& runtime, const ClPhaseBuffers& b, cons
     for (int it = 0; it < iterations; ++it) {
       arg(project_, 10, static_cast<cl_int>(it));
       arg(project_rows_, 10, static_cast<cl_int>(it));
-      for (uint32_t c = 0; c < distance + tether; ++c) {
-        uint32_t run = 0;
-        while (c + run < distance + tether && small(c + run)) ++run;
-        if (run >= 2) {
+      for (const auto& [c, run] : group_runs_) {
+        if (run > 1) {
           arg(project_rows_, 6, static_cast<cl_uint>(2 + c));
           arg(project_rows_, 7, static_cast<cl_uint>(run));
-          if (rc == CL_SUCCESS) {
-            cl_event* e = (first && !*first) ? first : nullptr;
-            rc = clEnqueueNDRangeKernel(q, project_rows_, 1, nullptr, &wg, &wg, 0, nullptr, e);
-            runtime.countLaunches();
-          }
-          c += run - 1;
+          launch(project_rows_, wg, false, true);
           continue;
         }
         const bool is_tether = c >= distance;

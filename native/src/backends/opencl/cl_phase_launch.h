@@ -8,6 +8,7 @@
 #include "drape_cl_types.h"
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace drape {
@@ -63,15 +64,17 @@ class ClPhaseKernels {
   bool create(cl_program program, std::string& err);
   // Queues the frame of every per-phase garment of `table` (plan.garments() entries, the same
   // as on the device in b.table), without waiting. Consecutive colour groups of at most a
-  // work-group's items each run in one launch of one work-group (drape_phase_project_rows). Substeps and passes run up to the largest
-  // of those garments'. first/last (optional): events of the first and the last launch (the
-  // kernel time), which the caller releases. CL_SUCCESS or the failing call's code.
+  // work-group's items (per garment) run in one launch of one work-group
+  // (drape_phase_project_rows). Substeps and passes run up to the largest of those garments'.
+  // first/last (optional): events of the first and the last launch (the kernel time), which the
+  // caller releases. CL_SUCCESS or the failing call's code.
   cl_int enqueue(ClRuntime& runtime, const ClPhaseBuffers& b, const ClPhasePlan& plan,
                  const DrapeClGarment* table, cl_event* first, cl_event* last);
 
  private:
   cl_kernel clear_stats_ = nullptr, pin_start_ = nullptr, predict_ = nullptr, pins_ = nullptr, project_ = nullptr,
             project_rows_ = nullptr, collide_velocity_ = nullptr;
+  std::vector<std::pair<uint32_t, uint32_t>> group_runs_;  // enqueue()'s scratch, kept between frames
 };
 
 }  // namespace drape
