@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <string>
@@ -221,6 +222,48 @@ TEST(GarmentTemplateInput, BadParamsRejectedAndOutputUntouched) {
   EXPECT_FALSE(makeGarmentTemplate(b.model, p, mesh, err));
   ASSERT_EQ(mesh.pinned.size(), 1u);
   EXPECT_EQ(mesh.pinned[0], 7u);
+}
+
+// Garments are cut with the arms 65 degrees down (capi/context.cpp, kGarmentRestArmDownDeg), where
+// the sleeve's underside is built partly inside the torso's ellipsoids. Pushed out of the torso's
+// and the arm's ellipsoids in turn, that strip of particles walked down the crease between them
+// to one point under each arm and was welded into one vertex: the T-shirt had an underarm vertex
+// of 12 neighbours at 1 802 particles and 36 at 32 168 (docs/garments.md, "The underarm fan").
+// A tube of rings has vertices of 6 neighbours, the zips between rings of other counts 7-8; the
+// nearest way out of the overlap (garment_templates.cpp, nearestExit) leaves at most 10 up to
+// 8 000 particles and 12 at 32 000, on the default body and on a thin and a heavy one.
+TEST(GarmentTemplateMesh, NoFanUnderTheArmsOnTheArmsDownCut) {
+  for (const auto& [height, weight] : {std::pair{1.70f, 65.0f}, std::pair{1.60f, 48.0f}, std::pair{1.80f, 110.0f}}) {
+    const ResolvedShape shape = Body::resolve(height, weight);
+    BodyModel model(shape, BodyModelParams{});
+    model.update(restPose(shape, 65.0f));
+    for (GarmentKind kind : {GarmentKind::TShirt, GarmentKind::LongSleeve, GarmentKind::Dress}) {
+      for (int target : {1000, 2000, 8000, 32000}) {
+        GarmentTemplateParams p;
+        p.kind = kind;
+        p.target_particles = target;
+        GarmentMesh mesh;
+        std::string err;
+        ASSERT_TRUE(makeGarmentTemplate(model, p, mesh, err)) << err;
+        std::vector<std::vector<uint32_t>> neighbours(mesh.positions.size());
+        for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+          for (size_t k = 0; k < 3; ++k) {
+            const uint32_t a = mesh.indices[t + k], b = mesh.indices[t + (k + 1) % 3];
+            neighbours[a].push_back(b);
+            neighbours[b].push_back(a);
+          }
+        }
+        size_t most = 0;
+        for (std::vector<uint32_t>& n : neighbours) {
+          std::sort(n.begin(), n.end());
+          most = std::max(most, static_cast<size_t>(std::unique(n.begin(), n.end()) - n.begin()));
+        }
+        EXPECT_LE(most, target > 8000 ? 12u : 10u)
+            << garmentKindName(kind) << ", " << target << " particles requested, body " << height << " m "
+            << weight << " kg";
+      }
+    }
+  }
 }
 
 // The same template fits both bodies: the heavy body's T-shirt is wider at the chest.

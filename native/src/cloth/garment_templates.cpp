@@ -122,6 +122,8 @@ std::vector<Sec> samplePath(const std::function<Sec(float)>& path, float h, cons
 }
 
 class Builder {
+  struct Inflated;  // below: an ellipsoid grown by the clearance, with its box
+
  public:
   Builder(const BodyModel& body, const GarmentTemplateParams& p, const std::vector<Ellipsoid>& ell,
           const std::vector<ProxySource>& src)
@@ -163,43 +165,105 @@ class Builder {
 
   // Moves every particle outside every ellipsoid inflated by `clear`, along the ellipsoid's
   // normal (Newton steps on the implicit), which keeps neighbours apart (a radial projection
-  // from the centre would squeeze them together).
+  // from the centre would squeeze them together); a particle trapped where two ellipsoids overlap
+  // (the crotch between the thighs) slides down the hip axis until outside all of them.
+  //
+  // Except where an arm meets the torso: a particle that the pushes send out of an arm's
+  // ellipsoid and out of another takes the nearest way out of all of them instead (nearestExit).
+  // Pushed out of each in turn, it went back and forth across the crease between the two and
+  // walked down it to the crease's lowest point, where every such particle ended together: on
+  // the pose garments are cut on (arms 65 degrees down) the strip of the sleeve's underside that
+  // is built inside the torso piled up at one point under each arm, weldShortEdges merged the
+  // pile, and the T-shirt had an underarm vertex of 12 neighbours (1 802 particles; 36 at
+  // 32 168) with edges of 7 to 115 mm (docs/garments.md, "The underarm fan").
   void pushOut(GarmentMesh& m, float clear) const {
     const std::vector<Inflated> inflated = inflate(clear);
-    for (int pass = 0; pass < 16; ++pass) {
-      bool moved = false;
-      for (Vec3& x : m.positions) {
-        for (const Inflated& in : inflated) {
-          if (!in.mayContain(x)) continue;  // outside the box: f >= 0 below, nothing to do
-          const Ellipsoid& e = in.e;
-          for (int it = 0; it < 20; ++it) {
-            const Vec3 q = e.toUnit(x);
-            const float f = q.squaredNorm() - 1.001f;
-            if (f >= 0.0f) break;
-            const Vec3 g = 2.0f * (e.to_unit.transpose() * q);
-            const float g2 = g.squaredNorm();
-            if (g2 < 1e-12f) {
-              x += e.rotation.col(0) * 1e-3f;
-              continue;
-            }
-            x -= (f - 1e-4f) / g2 * g;
-            moved = true;
-          }
-        }
-      }
-      if (!moved) return;
-    }
-    // Trapped between overlapping ellipsoids (e.g. the crotch between the thighs): slide down
-    // the hip axis until outside all of them.
-    const Vec3 down = -hip_.f.col(1);
     for (Vec3& x : m.positions) {
-      for (int step = 0; step < 100 && insideAny(inflated, x); ++step) x += 0.002f * down;
+      const Vec3 start = x;
+      if (pushOutAlongNormals(inflated, x)) {
+        x = start;
+        nearestExit(inflated, x);
+      }
     }
   }
 
   void finishPins(GarmentMesh& m) const { pinOffsetsFromPositions(body_, m); }
 
  private:
+  // Whether the pushes moved x out of an arm's ellipsoid and out of another ellipsoid.
+  bool pushOutAlongNormals(const std::vector<Inflated>& inflated, Vec3& x) const {
+    bool outOfArm = false, outOfOther = false;
+    for (int pass = 0; pass < 16; ++pass) {
+      bool moved = false;
+      for (size_t k = 0; k < inflated.size(); ++k) {
+        if (!inflated[k].mayContain(x)) continue;  // outside the box: f >= 0 below, nothing to do
+        if (!projectOut(inflated[k].e, x)) continue;
+        moved = true;
+        (isArm(k) ? outOfArm : outOfOther) = true;
+      }
+      if (!moved) break;
+    }
+    const Vec3 down = -hip_.f.col(1);
+    for (int step = 0; step < 100 && insideAny(inflated, x); ++step) x += 0.002f * down;
+    return outOfArm && outOfOther;
+  }
+  // Newton steps on the implicit of one ellipsoid, to just outside it; whether x moved.
+  static bool projectOut(const Ellipsoid& e, Vec3& x) {
+    bool moved = false;
+    for (int it = 0; it < 20; ++it) {
+      const Vec3 q = e.toUnit(x);
+      const float f = q.squaredNorm() - 1.001f;
+      if (f >= 0.0f) break;
+      const Vec3 g = 2.0f * (e.to_unit.transpose() * q);
+      const float g2 = g.squaredNorm();
+      if (g2 < 1e-12f) {
+        x += e.rotation.col(0) * 1e-3f;
+        continue;
+      }
+      x -= (f - 1e-4f) / g2 * g;
+      moved = true;
+    }
+    return moved;
+  }
+  bool isArm(size_t k) const {
+    return k < src_.size() && (src_[k].chain == Chain::ArmL || src_[k].chain == Chain::ArmR);
+  }
+  // The nearest way out of every ellipsoid: the shortest of kExitDirections rays spread over the
+  // sphere (a Fibonacci lattice), each followed in kExitStep steps to where it first leaves them
+  // all, then bisected to below 0.1 mm. Particles next to each other mostly leave the same way;
+  // where two leave on opposite sides of the arm the edge between them is long (the fan's edges
+  // were as long, and all met at one vertex).
+  void nearestExit(const std::vector<Inflated>& inflated, Vec3& x) const {
+    Vec3 best = x;
+    float bestT = kMaxExit;
+    for (int k = 0; k < kExitDirections; ++k) {
+      const float z = 1.0f - 2.0f * (static_cast<float>(k) + 0.5f) / static_cast<float>(kExitDirections);
+      const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+      const float phi = static_cast<float>(k) * 2.39996323f;  // the golden angle
+      const Vec3 d(r * std::cos(phi), r * std::sin(phi), z);
+      float inT = 0.0f, t = kExitStep;
+      while (t < bestT && insideAny(inflated, x + t * d)) {
+        inT = t;
+        t += kExitStep;
+      }
+      if (t >= bestT) continue;
+      for (int it = 0; it < 6; ++it) {  // 5 mm / 2^6 < 0.1 mm
+        const float mid = 0.5f * (inT + t);
+        if (insideAny(inflated, x + mid * d)) inT = mid;
+        else t = mid;
+      }
+      bestT = t;
+      best = x + t * d;
+    }
+    if (bestT < kMaxExit) {
+      x = best;
+      return;
+    }
+    pushOutAlongNormals(inflated, x);  // deeper than kMaxExit: the pushes after all
+  }
+  static constexpr int kExitDirections = 96;
+  static constexpr float kExitStep = 0.005f, kMaxExit = 0.15f;
+
   TemplateLayout* rec_ = nullptr;
   const TemplateLayout* play_ = nullptr;
   size_t nextCount_ = 0, nextRotation_ = 0;
