@@ -170,13 +170,13 @@ class Builder {
   //
   // Except where an arm meets the torso: a particle that the pushes send out of an arm's
   // ellipsoid and out of another takes the nearest way out of all of them, not upwards, instead
-  // (nearestExit).
-  // Pushed out of each in turn, it went back and forth across the crease between the two and
-  // walked down it to the crease's lowest point, where every such particle ended together: on
-  // the pose garments are cut on (arms 65 degrees down) the strip of the sleeve's underside that
-  // is built inside the torso piled up at one point under each arm, weldShortEdges merged the
-  // pile, and the T-shirt had an underarm vertex of 12 neighbours (1 802 particles; 36 at
-  // 32 168) with edges of 7 to 115 mm (docs/garments.md, "The underarm fan").
+  // (nearestExit). Pushed out of each in turn, it went back and forth across the crease between
+  // the two and walked down it to the crease's lowest point, where every such particle ended
+  // together: on the pose garments are cut on (arms 65 degrees down) the strip of the sleeve's
+  // underside that is built inside the torso piled up at one point under each arm,
+  // weldShortEdges merged the pile, and the T-shirt had an underarm vertex of 12 neighbours
+  // (1 802 particles; 36 at 32 168) with edges of 7 to 115 mm (docs/garments.md, "The underarm
+  // fan").
   void pushOut(GarmentMesh& m, float clear) const {
     const std::vector<Inflated> inflated = inflate(clear);
     for (Vec3& x : m.positions) {
