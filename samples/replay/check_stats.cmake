@@ -77,7 +77,8 @@ foreach(path "drape_version" "recording" "format" "layout" "frames" "rejected_fr
              "garment|kind" "garment|source" "garment|solver" "garment|substep_hz" "garment|iterations" "garment|triangles"
              "garment|edges" "garment|attached" "garment|frames_stepped" "garment|max_stretch"
              "garment|p99_stretch" "garment|proxy_inside" "garment|body_penetration_mm|p99"
-             "garment|body_penetration_mm|max" "garment|deeper_than_2mm" "garment|frames_measured"
+             "garment|body_penetration_mm|max" "garment|deeper_than_2mm" "garment|openings|tracked"
+             "garment|openings|off_frames" "garment|openings|off_max" "garment|frames_measured"
              "garment|teleport_resets" "garment|nan_resets" "garment|contacts" "garment|substeps"
              "render|frames_rendered" "render|every" "render|camera" "render|width" "render|height"
              "render|contact_sheet" "render|gif" "render|mp4" "render|ms_per_frame_median")

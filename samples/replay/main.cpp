@@ -473,6 +473,9 @@ int run(int argc, char** argv) {
       st.penetration_p99_mm.push_back(acc.body_penetration_p99_mm);
       st.penetration_max_mm.push_back(acc.body_penetration_max_mm);
       st.deeper_than_2mm.push_back(acc.deeper_than_2mm);
+      st.openings = acc.openings;
+      st.openings_off_frames += acc.openings_off > 0 ? 1u : 0u;
+      st.openings_off_max = std::max(st.openings_off_max, acc.openings_off);
     }
 
     if (drape_result r = drape_garment_read_mesh(garment, garment_positions.data(),

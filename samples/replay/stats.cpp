@@ -209,6 +209,11 @@ std::string statsJson(const ReplayStats& s) {
   w.key("max").value(maximum(s.penetration_max_mm));
   w.endObject();
   w.key("deeper_than_2mm").value(mean(s.deeper_than_2mm));
+  w.key("openings").beginObject();
+  w.key("tracked").value(s.openings);
+  w.key("off_frames").value(s.openings_off_frames);
+  w.key("off_max").value(s.openings_off_max);
+  w.endObject();
   w.key("frames_measured").value(static_cast<uint32_t>(s.penetration_p99_mm.size()));
   w.key("teleport_resets").value(s.teleport_resets);
   w.key("nan_resets").value(s.nan_resets);
@@ -286,6 +291,10 @@ std::string summaryText(const ReplayStats& s, const std::string& obj_dir, const 
                  "max %.2f mm; %.3f %% deeper than 2 mm (mean of %zu measured frames)\n",
           static_cast<unsigned long long>(s.proxy_inside), maximum(s.penetration_p99_mm),
           maximum(s.penetration_max_mm), 100.0 * mean(s.deeper_than_2mm), s.penetration_p99_mm.size());
+    if (!s.penetration_p99_mm.empty())
+      appendf(o, "openings    %u round a body part when dressed; one or more off it in %u of %zu measured frames "
+                 "(at most %u at once)\n",
+          s.openings, s.openings_off_frames, s.penetration_p99_mm.size(), s.openings_off_max);
     appendf(o, "cloth       %.0f contacts, %.0f substeps per frame (median); %u teleport resets, %u NaN resets\n",
         median(s.contacts), median(s.substeps), s.teleport_resets, s.nan_resets);
   } else {

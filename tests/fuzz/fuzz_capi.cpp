@@ -474,11 +474,13 @@ struct Machine {
       for (uint32_t i = 0; i < nv; ++i) DRAPE_FUZZ_CHECK(finite3(pos[i]), "rest positions finite");
     drape_garment_accuracy a;
     a.struct_size = (which & 8) ? in.u8() : sizeof a;
-    if (DRAPE_FUZZ_CALL(drape_garment_measure(g, &a)) == DRAPE_OK)
+    if (DRAPE_FUZZ_CALL(drape_garment_measure(g, &a)) == DRAPE_OK) {
       DRAPE_FUZZ_CHECK(std::isfinite(a.max_stretch) && std::isfinite(a.p99_stretch) && std::isfinite(a.mean_stretch) &&
                            std::isfinite(a.body_penetration_p99_mm) && std::isfinite(a.body_penetration_max_mm) &&
                            std::isfinite(a.deeper_than_2mm),
                        "garment accuracy finite");
+      if (a.struct_size == sizeof a) DRAPE_FUZZ_CHECK(a.openings_off <= a.openings, "openings off <= openings");
+    }
     if (live) checkGarment(g);
   }
 

@@ -27,6 +27,8 @@ struct SceneSummary {
   bool finite = true;
   int nan_resets = 0, teleport_resets = 0;
   double step_ms_median = 0.0;
+  uint32_t openings = 0;           // (opening, body part) pairs tracked (cloth/garment_openings.h)
+  int openings_off_frames = 0;     // frames with at least one of them off its body part
 };
 
 inline drape_context_desc defaultDesc() {
@@ -117,10 +119,12 @@ inline SceneSummary replay(Context& ctx, GarmentSim& garment, const Recording& r
       return s;
     }
     const GarmentAccuracy a = measure_body ? ctx.measureGarment(garment)
-                                           : garment.measure(ctx.proxies().ellipsoids(), nullptr);
+                                           : garment.measure(ctx.proxies().ellipsoids(), nullptr, &ctx.body());
     s.max_stretch = std::max(s.max_stretch, a.stretch.max);
     p99s.push_back(a.stretch.p99);
     s.proxy_inside += a.proxy_inside;
+    s.openings = a.openings.tracked;
+    s.openings_off_frames += a.openings.off > 0 ? 1 : 0;
     s.penetration_p99_max_mm = std::max(s.penetration_p99_max_mm, a.body_penetration_p99_mm);
     s.penetration_max_mm = std::max(s.penetration_max_mm, a.body_penetration_max_mm);
     s.max_speed = std::max(s.max_speed, maxSpeed(garment.velocities(), garment.particleCount()));

@@ -167,6 +167,36 @@ TEST(CApiGarments, StatsOfTheFirstStructVersionAreStillFilled) {
   for (size_t k = sizeof(uint32_t); k < sizeof(buf); ++k) ASSERT_EQ(buf[k], 0xAB) << "byte " << k << " written on error";
 }
 
+TEST(CApiGarments, AccuracyCountsOpeningsAndTheFirstStructVersionIsStillFilled) {
+  ContextPtr ctx = makeContext();
+  drape_garment* g = addTShirt(ctx.get());
+  ASSERT_NE(g, nullptr);
+  for (int i = 0; i < 3; ++i) ASSERT_OK(pushAndStep(ctx.get(), i));
+  drape_garment_accuracy full;
+  full.struct_size = sizeof(full);
+  ASSERT_OK(drape_garment_measure(g, &full));
+  EXPECT_EQ(full.struct_size, 40u);
+  EXPECT_EQ(full.openings, 4u);  // hem, collar, two sleeves
+  EXPECT_EQ(full.openings_off, 0u);
+  // A caller built against the 32-byte first version: its fields, nothing past them.
+  alignas(drape_garment_accuracy) unsigned char buf[sizeof(drape_garment_accuracy)];
+  std::memset(buf, 0xAB, sizeof(buf));
+  const uint32_t v1 = 32;
+  std::memcpy(buf, &v1, sizeof(v1));
+  ASSERT_OK(drape_garment_measure(g, reinterpret_cast<drape_garment_accuracy*>(buf)));
+  EXPECT_EQ(std::memcmp(buf + sizeof(uint32_t), reinterpret_cast<const unsigned char*>(&full) + sizeof(uint32_t), v1 - sizeof(uint32_t)), 0);
+  uint32_t written = 0;
+  std::memcpy(&written, buf, sizeof(written));
+  EXPECT_EQ(written, v1);
+  for (size_t k = v1; k < sizeof(buf); ++k) ASSERT_EQ(buf[k], 0xAB) << "byte " << k << " written past struct_size";
+  std::memset(buf, 0xAB, sizeof(buf));
+  const uint32_t too_small = v1 - 4;
+  std::memcpy(buf, &too_small, sizeof(too_small));
+  EXPECT_FAILS(DRAPE_ERROR_INVALID_ARGUMENT, "drape_garment_accuracy.struct_size",
+               drape_garment_measure(g, reinterpret_cast<drape_garment_accuracy*>(buf)));
+  for (size_t k = sizeof(uint32_t); k < sizeof(buf); ++k) ASSERT_EQ(buf[k], 0xAB) << "byte " << k << " written on error";
+}
+
 TEST(CApiGarments, SameInputGivesBitIdenticalGarments) {
   ContextPtr a = makeContext(), b = makeContext();
   // Under the sanitizers 400 particles instead of 1 000: the same code runs for every particle of

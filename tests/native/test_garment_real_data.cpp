@@ -20,17 +20,20 @@ struct Take {
   const char* file;
   float p99_bound;  // per-frame P99 stretch, worst frame: measured worst + ~25 % (the CMU takes
                     // swing between 0.75 and 1.15 from one setting to the next: chaotic)
+  bool stays_on;    // every opening stays round its body part in every frame (docs/garments.md,
+                    // "Openings": on Ges01 the waving arm leaves its sleeve, on the CMU takes the
+                    // sleeves are off the bent arms; those are measured, not yet fixed)
 };
 
 const Take kTakes[] = {
-    {"kinect_v2_msft_labanotation/Ges01_wavehand.csv", 1.0f},
-    {"kinect_v2_msft_labanotation/Ges02_balancinghands.csv", 0.4f},
-    {"kinect_v2_msft_labanotation/Ges04_comehere.csv", 0.45f},
-    {"kinect_v2_msft_labanotation/KinectReader_joints_closerange.csv", 0.95f},
-    {"cmu_mocap_bvh/131_01.bvh", 1.3f},
-    {"cmu_mocap_bvh/131_03.bvh", 1.3f},
-    {"cmu_mocap_bvh/scaled_131_01.bvh", 1.3f},
-    {"cmu_mocap_bvh/scaled_131_03.bvh", 1.3f},
+    {"kinect_v2_msft_labanotation/Ges01_wavehand.csv", 1.0f, false},
+    {"kinect_v2_msft_labanotation/Ges02_balancinghands.csv", 0.4f, true},
+    {"kinect_v2_msft_labanotation/Ges04_comehere.csv", 0.45f, true},
+    {"kinect_v2_msft_labanotation/KinectReader_joints_closerange.csv", 0.95f, true},
+    {"cmu_mocap_bvh/131_01.bvh", 1.3f, false},
+    {"cmu_mocap_bvh/131_03.bvh", 1.3f, false},
+    {"cmu_mocap_bvh/scaled_131_01.bvh", 1.3f, false},
+    {"cmu_mocap_bvh/scaled_131_03.bvh", 1.3f, false},
 };
 
 class GarmentOnRecording : public ::testing::TestWithParam<Take> {};
@@ -44,15 +47,18 @@ TEST_P(GarmentOnRecording, TShirtStaysFiniteOutsideAndBounded) {
   GarmentSim* g = test::addTemplate(ctx, GarmentKind::TShirt, 1000, ClothSolverKind::Xpbd, GarmentSimParams{}, err);
   ASSERT_NE(g, nullptr) << err;
   const test::SceneSummary s = test::replay(ctx, *g, rec, err, /*measure_body=*/false);
-  std::printf("[ figures  ] %s: %d frames, P99 stretch median %.3f worst %.3f, max %.3f, inside %llu, vmax %.2f m/s\n",
+  std::printf("[ figures  ] %s: %d frames, P99 stretch median %.3f worst %.3f, max %.3f, inside %llu, vmax %.2f m/s, "
+              "%u openings, off in %d frames\n",
               GetParam().file, s.frames, s.p99_stretch_median, s.p99_stretch_worst, s.max_stretch,
-              static_cast<unsigned long long>(s.proxy_inside), s.max_speed);
+              static_cast<unsigned long long>(s.proxy_inside), s.max_speed, s.openings, s.openings_off_frames);
   ASSERT_EQ(s.frames, static_cast<int>(rec.frames.size())) << err;
   EXPECT_TRUE(s.finite);
   EXPECT_EQ(s.nan_resets, 0);
   EXPECT_LT(static_cast<double>(s.proxy_inside), 0.005 * s.frames * static_cast<double>(g->particleCount()));
   EXPECT_LT(s.max_speed, 50.0f);  // limbs reach 10-15 m/s; corrections add to that, explosions far more
   EXPECT_LT(s.p99_stretch_worst, GetParam().p99_bound);
+  EXPECT_EQ(s.openings, 4u);  // hem, collar, two sleeves
+  if (GetParam().stays_on) EXPECT_EQ(s.openings_off_frames, 0) << "an opening left its body part";
 }
 
 INSTANTIATE_TEST_SUITE_P(SharedData, GarmentOnRecording, ::testing::ValuesIn(kTakes),

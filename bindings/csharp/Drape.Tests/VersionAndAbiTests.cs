@@ -210,9 +210,10 @@ namespace Drape.Tests
             ("DeviceHostMs", 96));
 
         [Fact]
-        public void GarmentAccuracy_Is32() => AssertLayout<GarmentAccuracy>(32,
+        public void GarmentAccuracy_Is40() => AssertLayout<GarmentAccuracy>(40,
             ("StructSize", 0), ("ProxyInside", 4), ("MaxStretch", 8), ("P99Stretch", 12), ("MeanStretch", 16),
-            ("BodyPenetrationP99Mm", 20), ("BodyPenetrationMaxMm", 24), ("DeeperThan2mm", 28));
+            ("BodyPenetrationP99Mm", 20), ("BodyPenetrationMaxMm", 24), ("DeeperThan2mm", 28), ("Openings", 32),
+            ("OpeningsOff", 36));
 
         [Fact]
         public void RecordingInfo_Is32() => AssertLayout<RecordingInfo>(32,

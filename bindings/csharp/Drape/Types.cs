@@ -705,8 +705,8 @@ namespace Drape
         public bool IsNanReset => NanReset != 0;
     }
 
-    /// <summary>drape_garment_accuracy (32 bytes): how accurate the garment is now (a diagnostic,
-    /// about 1 ms per 1 000 particles).</summary>
+    /// <summary>drape_garment_accuracy (40 bytes; 32 before the openings): how accurate the garment
+    /// is now (a diagnostic, about 1 ms per 1 000 particles).</summary>
     [StructLayout(LayoutKind.Sequential)]
     public struct GarmentAccuracy
     {
@@ -726,5 +726,11 @@ namespace Drape
         public float BodyPenetrationMaxMm;
         /// <summary>deeper_than_2mm: fraction of vertices more than 2 mm inside the body.</summary>
         public float DeeperThan2mm;
+        /// <summary>openings: the garment's openings (boundary loops: hem, collar, sleeve cuffs, trouser
+        /// legs) that went round a body part when it was dressed.</summary>
+        public uint Openings;
+        /// <summary>openings_off: of those, the ones off their body part now (a sleeve the arm has
+        /// left).</summary>
+        public uint OpeningsOff;
     }
 }

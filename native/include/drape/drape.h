@@ -612,7 +612,9 @@ typedef struct drape_garment_stats {
 DRAPE_API drape_result DRAPE_CALL drape_garment_get_stats(drape_garment* garment,
                                                           drape_garment_stats* out_stats);
 
-/* Accuracy of the garment now (a diagnostic, ~1 ms per 1 000 particles). */
+/* Accuracy of the garment now (a diagnostic, ~1 ms per 1 000 particles). The struct grew from
+ * 32 to 40 bytes (openings); a caller passing the first version's struct_size (32) gets those
+ * fields as before and nothing written past them. */
 typedef struct drape_garment_accuracy {
   uint32_t struct_size;            /* caller sets sizeof(drape_garment_accuracy) */
   uint32_t proxy_inside;           /* particles inside an ellipsoid they collide with, > 0.1 mm */
@@ -622,6 +624,12 @@ typedef struct drape_garment_accuracy {
   float body_penetration_p99_mm;   /* depth of vertices inside the body mesh (0 before an update) */
   float body_penetration_max_mm;
   float deeper_than_2mm;           /* fraction of vertices more than 2 mm inside the body */
+  /* Openings: the mesh's boundary loops (hem, collar, sleeve cuffs, trouser legs) that went
+   * round a body part when the garment was dressed (a sleeve round its arm, a collar round the
+   * spine); openings_off: how many of them are off it now (a sleeve the arm has left, a trouser
+   * leg the foot came out of through the cloth). docs/garments.md, "Openings". */
+  uint32_t openings;
+  uint32_t openings_off;
 } drape_garment_accuracy;
 
 DRAPE_API drape_result DRAPE_CALL drape_garment_measure(drape_garment* garment,

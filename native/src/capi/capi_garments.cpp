@@ -582,7 +582,10 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_measure(drape_garment* handle, d
   return guarded("drape_garment_measure", [&]() -> drape_result {
     DRAPE_CHECK_GARMENT("drape_garment_measure", handle);
     if (!out) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_garment_measure: out_accuracy is NULL");
-    if (drape_result r = checkStructSize(out->struct_size, sizeof(drape_garment_accuracy), "drape_garment_accuracy")) return r;
+    // The first version of the struct (up to openings: 32 bytes) is still accepted: the caller's
+    // struct_size says how many bytes are its own.
+    constexpr uint32_t kFirstVersionSize = offsetof(drape_garment_accuracy, openings);
+    if (drape_result r = checkStructSize(out->struct_size, kFirstVersionSize, "drape_garment_accuracy")) return r;
     const drape::GarmentAccuracy a = static_cast<Context*>(garment->api_owner)->measureGarment(*garment);
     drape_garment_accuracy o;
     std::memset(&o, 0, sizeof(o));
@@ -594,7 +597,10 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_measure(drape_garment* handle, d
     o.body_penetration_p99_mm = a.body_penetration_p99_mm;
     o.body_penetration_max_mm = a.body_penetration_max_mm;
     o.deeper_than_2mm = a.deeper_than_2mm;
-    *out = o;
+    o.openings = a.openings.tracked;
+    o.openings_off = a.openings.off;
+    o.struct_size = std::min<uint32_t>(out->struct_size, sizeof(o));
+    std::memcpy(out, &o, o.struct_size);
     return DRAPE_OK;
   });
 }
@@ -606,5 +612,6 @@ static_assert(sizeof(drape_garment_template) == 24, "drape_garment_template layo
 static_assert(sizeof(drape_mesh_fit) == 48, "drape_mesh_fit layout");
 static_assert(sizeof(drape_garment_stats) == 104, "drape_garment_stats layout");
 static_assert(offsetof(drape_garment_stats, device_upload_ms) == 72, "drape_garment_stats: the first version's 72 bytes moved");
-static_assert(sizeof(drape_garment_accuracy) == 32, "drape_garment_accuracy layout");
+static_assert(sizeof(drape_garment_accuracy) == 40, "drape_garment_accuracy layout");
+static_assert(offsetof(drape_garment_accuracy, openings) == 32, "drape_garment_accuracy: the first version's 32 bytes moved");
 static_assert(sizeof(drape_cloth_params) == 128, "drape_cloth_params layout");

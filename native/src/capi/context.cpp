@@ -524,9 +524,9 @@ drape_result Context::stepContexts(Context* const* contexts, size_t count, float
 }
 
 GarmentAccuracy Context::measureGarment(const GarmentSim& garment) {
-  if (!updated_) return garment.measure(restEllipsoids(), nullptr);
+  if (!updated_) return garment.measure(restEllipsoids(), nullptr, &restBody());
   refreshBvh();
-  return garment.measure(proxies().ellipsoids(), &bvh_);
+  return garment.measure(proxies().ellipsoids(), &bvh_, &body());
 }
 
 }  // namespace drape

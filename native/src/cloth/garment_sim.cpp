@@ -275,6 +275,7 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
     }
   }
   g->skin_.bind(body_rest, g->dressed_, kSkinBlendM);
+  g->openings_.bind(g->mesh_.indices, g->dressed_, body_rest);
   g->last_ = GarmentStepStats{};
   return g;
 }
@@ -600,7 +601,8 @@ const std::vector<Vec3>& GarmentSim::normals() const {
   return normals_;
 }
 
-GarmentAccuracy GarmentSim::measure(const std::vector<Ellipsoid>& ellipsoids, const TriangleBvh* bvh) const {
+GarmentAccuracy GarmentSim::measure(const std::vector<Ellipsoid>& ellipsoids, const TriangleBvh* bvh,
+                                    const BodyModel* body) const {
   GarmentAccuracy a;
   std::vector<float> scratch;
   const Eigen::Vector4f* x = solver_->x();
@@ -639,6 +641,7 @@ GarmentAccuracy GarmentSim::measure(const std::vector<Ellipsoid>& ellipsoids, co
       a.deeper_than_2mm = static_cast<float>(deep) / static_cast<float>(scratch.size());
     }
   }
+  if (body != nullptr) a.openings = openings_.count(x, particleCount(), *body);
   return a;
 }
 

@@ -19,6 +19,7 @@
 #include "cloth/garment_templates.h"
 #include "cloth/garment_topology.h"
 #include "cloth/mass_spring_solver.h"
+#include "cloth/garment_openings.h"
 #include "cloth/ring_skin.h"
 #include "cloth/xpbd_solver.h"
 #include "proxies/collision.h"
@@ -98,6 +99,8 @@ struct GarmentAccuracy {
   float body_penetration_p99_mm = 0;   // depth of garment vertices inside the body mesh
   float body_penetration_max_mm = 0;
   float deeper_than_2mm = 0;           // fraction of vertices more than 2 mm inside the body
+  OpeningCount openings;               // openings round a body part at rest, and those off it now
+                                       // (cloth/garment_openings.h); 0 / 0 without a body
 };
 
 class GarmentSim {
@@ -207,8 +210,11 @@ class GarmentSim {
   void setTrackingNoise(float sigma_m) { tracking_noise_m_ = sigma_m >= 0.0f ? sigma_m : 0.0f; }
   uint64_t steps() const { return steps_; }
 
-  // Accuracy now against `ellipsoids` and, when `body_bvh` is non-null, the body mesh it holds.
-  GarmentAccuracy measure(const std::vector<Ellipsoid>& ellipsoids, const TriangleBvh* body_bvh) const;
+  // Accuracy now against `ellipsoids` and, when `body_bvh` is non-null, the body mesh it holds;
+  // with `body` (the body now, same ring layout as at dressing), whether the openings still go
+  // round the body parts they went round when dressed.
+  GarmentAccuracy measure(const std::vector<Ellipsoid>& ellipsoids, const TriangleBvh* body_bvh,
+                          const BodyModel* body = nullptr) const;
 
   struct Solver;  // the solver behind the garment (cloth/garment_solver.h)
   Solver* solverFace() { return solver_.get(); }
@@ -319,6 +325,7 @@ class GarmentSim {
   // The dressed shape on the rest pose, bound to the rest body's rings.
   std::vector<Vec3> dressed_;
   RingSkin skin_;
+  GarmentOpenings openings_;  // bound with skin_, to the dressed garment on the rest body
 
   // Per-step scratch (sized once).
   std::vector<Vec3> pins_, scratch3_;

@@ -1,0 +1,75 @@
+// A garment's openings (the loops of its boundary: hem, collar, sleeve cuffs, trouser legs) and
+// the body parts each goes round, so a measurement can tell when one no longer does: a sleeve the
+// arm has left, a collar off the neck. Stretch and penetration do not see that failure (a sleeve
+// lying empty on the shoulder is neither stretched nor inside the body), pictures do.
+//
+// A body part is the polyline through a chain's ring centres (body/body_model.h); the spine runs
+// through the torso's and then the head's rings, and on below the pelvis ring (kSpineExtensionM,
+// away from the waist ring) so that a hem below the hips still goes round it; legs start in the
+// pelvis (kLegExtensionM), arms are not (a sleeve that slides off the shoulder end is
+// off). How much an opening goes round a polyline is their Gauss linking integral: +-1 for a loop
+// round a line that runs far on both sides, whatever the loop's shape (a crumpled trouser hem
+// round an ankle too), +-1/2 when the loop's centre is at the polyline's end, 0 for a loop beside
+// it. At bind time (the dressed garment on the rest body) every opening records the body part it
+// goes round most (|linking| >= kBindLinking; a T-shirt's hem goes round the spine and both legs,
+// the spine most); count() says how many openings are off theirs now: linking of the same sign
+// below kOffLinking, i.e. the loop has slid past the polyline's end or the body part has left it
+// through the cloth. Openings no polyline goes through at rest are not tracked (a cut that never
+// went round anything cannot come off it).
+#pragma once
+
+#include "body/body_model.h"
+#include "common/math.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace drape {
+
+// The closed boundary loops of a triangle mesh, each in order along the loop. Edges used by one
+// triangle are boundary edges; a vertex where boundary loops touch (two boundary edges in and
+// two out) ends up in each loop that passes it. Loops shorter than three vertices are dropped.
+std::vector<std::vector<uint32_t>> boundaryLoops(const std::vector<uint32_t>& triangles, size_t vertex_count);
+
+// Gauss linking integral of the closed loop (last vertex joined to the first) and the open
+// polyline: the sum over segment pairs of the signed solid angle, over 4 pi.
+float loopLinking(const std::vector<Vec3>& loop, const std::vector<Vec3>& polyline);
+
+struct OpeningCount {
+  uint32_t tracked = 0;  // openings round a body part at rest
+  uint32_t off = 0;      // of those, the ones off it now
+};
+
+class GarmentOpenings {
+ public:
+  // Below the pelvis ring, the spine goes on this far (metres) for hems below the hips.
+  static constexpr float kSpineExtensionM = 0.5f;
+  // An opening goes round a body part at rest from this much linking, and is off it below
+  // kOffLinking (same sign): its centre past the polyline's end, or the part out through the cloth.
+  static constexpr float kBindLinking = 0.75f;
+  static constexpr float kOffLinking = 0.5f;
+  // A leg starts this far above its thigh ring, in the pelvis: a hem round both legs at the hips
+  // (a T-shirt's, a skirt's) stays round them when the thigh ring moves past it.
+  static constexpr float kLegExtensionM = 0.15f;
+
+  // The openings of `triangles` and the body part each goes round with the garment at `positions`
+  // on `body_rest` (a BodyModel updated with its rest pose).
+  void bind(const std::vector<uint32_t>& triangles, const std::vector<Vec3>& positions, const BodyModel& body_rest);
+  // The same count for positions now (xyz of x[0 .. n)) on `body` (the same ring layout).
+  OpeningCount count(const Eigen::Vector4f* x, size_t n, const BodyModel& body) const;
+
+  size_t openingCount() const { return loops_.size(); }
+  // The body-part polylines (spine, arms, legs) of `body`: see the file comment.
+  static std::vector<std::vector<Vec3>> bodyPolylines(const BodyModel& body);
+
+ private:
+  struct Pair {  // an opening and its body part
+    uint32_t loop;
+    uint32_t polyline;
+    int sign;  // of the linking at rest
+  };
+  std::vector<std::vector<uint32_t>> loops_;
+  std::vector<Pair> pairs_;
+};
+
+}  // namespace drape

@@ -1,0 +1,117 @@
+// Openings (cloth/garment_openings.h): the boundary loops of a mesh, the linking integral of a loop
+// and a polyline, and every template's openings on the body it was dressed on, then carried off it.
+#include "cloth/garment_openings.h"
+#include "cloth/garment_solver.h"
+#include "cloth/garment_topology.h"
+#include "garment_scene.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace drape {
+namespace {
+
+// A closed loop of n points round the z axis, radius r at height z; `wiggle` moves every other
+// point up and down by that much (a crumpled hem).
+std::vector<Vec3> openingCircle(int n, float r, float z, float wiggle = 0.0f) {
+  std::vector<Vec3> loop;
+  for (int k = 0; k < n; ++k) {
+    const float a = 2.0f * kPi * static_cast<float>(k) / static_cast<float>(n);
+    loop.emplace_back(r * std::cos(a), r * std::sin(a), z + ((k % 2) != 0 ? wiggle : -wiggle));
+  }
+  return loop;
+}
+
+std::vector<Vec3> openingLine(float z0, float z1, float x = 0.0f, int segments = 10) {
+  std::vector<Vec3> line;
+  for (int s = 0; s <= segments; ++s)
+    line.emplace_back(x, 0.0f, z0 + (z1 - z0) * static_cast<float>(s) / static_cast<float>(segments));
+  return line;
+}
+
+TEST(GarmentOpeningsGeometry, BoundaryLoopsOfAGridATubeAndAClosedSurface) {
+  std::vector<float> flat;
+  std::vector<uint32_t> indices;
+  makeClothGrid(6, 4, 1.0f, 1.0f, Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), flat, indices);
+  const std::vector<std::vector<uint32_t>> grid = boundaryLoops(indices, flat.size() / 3);
+  ASSERT_EQ(grid.size(), 1u);
+  EXPECT_EQ(grid[0].size(), static_cast<size_t>(2 * (6 + 4) - 4));
+
+  // A tube: the grid's first and last columns joined -> two loops of 6 (its ends).
+  const int nx = 6, ny = 4;
+  std::vector<uint32_t> tube;
+  for (int j = 0; j + 1 < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const auto id = [&](int a, int b) { return static_cast<uint32_t>(b * nx + (a % nx)); };
+      tube.insert(tube.end(), {id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  const std::vector<std::vector<uint32_t>> ends = boundaryLoops(tube, static_cast<size_t>(nx * ny));
+  ASSERT_EQ(ends.size(), 2u);
+  EXPECT_EQ(ends[0].size(), 6u);
+  EXPECT_EQ(ends[1].size(), 6u);
+
+  // A tetrahedron has no boundary; indices out of range are ignored, not read.
+  const std::vector<uint32_t> tetra = {0, 2, 1, 0, 1, 3, 1, 2, 3, 0, 3, 2};
+  EXPECT_TRUE(boundaryLoops(tetra, 4).empty());
+  EXPECT_TRUE(boundaryLoops({0, 1, 7}, 3).empty());
+}
+
+TEST(GarmentOpeningsGeometry, LinkingOfALoopAndALine) {
+  const std::vector<Vec3> loop = openingCircle(48, 0.05f, 0.0f);
+  // Through the middle, far on both sides: +-1 (the sign follows the directions).
+  EXPECT_NEAR(loopLinking(loop, openingLine(-5.0f, 5.0f)), 1.0f, 0.02f);
+  EXPECT_NEAR(loopLinking(loop, openingLine(5.0f, -5.0f)), -1.0f, 0.02f);
+  // Ending at the loop's centre: one half. Beside it or short of it: about 0.
+  EXPECT_NEAR(loopLinking(loop, openingLine(-5.0f, 0.0f)), 0.5f, 0.02f);
+  EXPECT_NEAR(std::fabs(loopLinking(loop, openingLine(-5.0f, 5.0f, 0.2f))), 0.0f, 0.02f);
+  EXPECT_NEAR(std::fabs(loopLinking(loop, openingLine(-5.0f, -0.3f))), 0.0f, 0.03f);
+  // A crumpled loop (every other point 4 cm up or down) still goes round once.
+  EXPECT_NEAR(loopLinking(openingCircle(48, 0.05f, 0.0f, 0.04f), openingLine(-5.0f, 5.0f)), 1.0f, 0.03f);
+  // A line through the loop's points or along its plane: finite, no NaN.
+  const std::vector<Vec3> through = {Vec3(0.05f, 0.0f, -1.0f), Vec3(0.05f, 0.0f, 1.0f)};
+  EXPECT_TRUE(std::isfinite(loopLinking(loop, through)));
+  EXPECT_EQ(loopLinking({}, openingLine(-1.0f, 1.0f)), 0.0f);
+  EXPECT_EQ(loopLinking(loop, {Vec3::Zero()}), 0.0f);
+}
+
+struct OpeningsOfKind {
+  GarmentKind kind;
+  uint32_t openings;  // hem, collar and sleeves; waistband and legs; a skirt's hem and waistband
+};
+
+class GarmentOpeningsOfTemplates : public ::testing::TestWithParam<OpeningsOfKind> {};
+
+TEST_P(GarmentOpeningsOfTemplates, EveryOpeningRoundItsBodyPartUntilCarriedOff) {
+  Context ctx(test::defaultDesc());
+  std::string err;
+  GarmentSim* g = test::addTemplate(ctx, GetParam().kind, 1000, ClothSolverKind::Xpbd, GarmentSimParams{}, err);
+  ASSERT_NE(g, nullptr) << err;
+  const GarmentAccuracy dressed = g->measure(ctx.restEllipsoids(), nullptr, &ctx.restBody());
+  EXPECT_EQ(dressed.openings.tracked, GetParam().openings);
+  EXPECT_EQ(dressed.openings.off, 0u);
+  // Without a body, nothing is counted.
+  EXPECT_EQ(g->measure(ctx.restEllipsoids(), nullptr).openings.tracked, 0u);
+
+  // Carried 1 m sideways, off the body: every opening is off.
+  Eigen::Vector4f* x = g->solverFace()->mutableX();
+  for (size_t i = 0; i < g->particleCount(); ++i) x[i].x() += 1.0f;
+  const GarmentAccuracy carried = g->measure(ctx.restEllipsoids(), nullptr, &ctx.restBody());
+  EXPECT_EQ(carried.openings.tracked, GetParam().openings);
+  EXPECT_EQ(carried.openings.off, GetParam().openings);
+}
+
+INSTANTIATE_TEST_SUITE_P(Kinds, GarmentOpeningsOfTemplates,
+                         ::testing::Values(OpeningsOfKind{GarmentKind::TShirt, 4}, OpeningsOfKind{GarmentKind::LongSleeve, 4},
+                                           OpeningsOfKind{GarmentKind::Dress, 4}, OpeningsOfKind{GarmentKind::Skirt, 2},
+                                           OpeningsOfKind{GarmentKind::Trousers, 3}),
+                         [](const ::testing::TestParamInfo<OpeningsOfKind>& info) {
+                           std::string name = garmentKindName(info.param.kind);
+                           name.erase(std::remove(name.begin(), name.end(), '-'), name.end());
+                           return name;
+                         });
+
+}  // namespace
+}  // namespace drape
