@@ -176,6 +176,7 @@ struct Runner {
     r.deeper_than_2mm = measured.deeper_than_2mm;
     r.inside_mean = measured.inside_mean;
     r.inside_max = measured.inside_max;
+    r.openings_off = measured.openings_off;
     r.nan_resets = measured.nan_resets;
     // The converged reference of the same input, shared by every setting that differs only in
     // substeps and iterations.

@@ -84,17 +84,17 @@ std::string renderReport(const ReportInput& in) {
   for (size_t k = 0; k < in.sweeps.size(); ++k) {
     appendf(o, "\n## %s (`%s.csv`)\n\n", in.sweeps[k].title.c_str(), in.sweeps[k].name.c_str());
     o += "| setting | take | frame ms | cloth ms | collide ms | deviation mm RMS / max | stretch % P99 / max | "
-         "penetration mm P99 / max | > 2 mm % | inside | energy drift "
-         "|\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+         "penetration mm P99 / max | > 2 mm % | inside | openings off % | energy drift "
+         "|\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const Row& r : in.rows[k]) {
       char energy[32];
       std::snprintf(energy, sizeof energy, "%+.4f", r.energy.drift);
       appendf(
-          o, "| %s%s | %s | %.3f (%.3f) | %.3f | %.3f | %.2f / %.1f | %.2f / %.1f | %.2f / %.1f | %.3f | %.2f | %s |\n",
+          o, "| %s%s | %s | %.3f (%.3f) | %.3f | %.3f | %.2f / %.1f | %.2f / %.1f | %.2f / %.1f | %.3f | %.2f | %.0f | %s |\n",
           r.setting.label.c_str(), r.setting.is_default ? " **(default)**" : "", r.take.c_str(), r.frame.median,
           r.frame.p90, r.cloth.median, r.collide.median, r.dev_rms_mm, r.dev_max_mm, 100.0 * r.stretch_p99,
           100.0 * r.stretch_max, r.pen_p99_mm, r.pen_max_mm, 100.0 * r.deeper_than_2mm, r.inside_mean,
-          r.energy.exploded ? "exploded" : energy);
+          100.0 * r.openings_off, r.energy.exploded ? "exploded" : energy);
     }
     for (const Row& r : in.rows[k])
       if (!r.device.empty())

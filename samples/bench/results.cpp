@@ -58,14 +58,14 @@ bool writeRowsCsv(const std::string& path, const std::vector<Row>& rows, std::st
       "proxies_ms_median,proxies_ms_p90,cloth_ms_median,cloth_ms_p90,integrate_ms_median,integrate_ms_p90,"
       "collide_ms_median,collide_ms_p90,ms_per_sim_s,dev_rms_mm,dev_max_mm,stretch_p99_pct,stretch_max_pct,"
       "pen_p99_mm,pen_max_mm,deeper_2mm_pct,inside_mean,inside_max,energy_drift,energy_worst,"
-      "energy_exploded,nan_resets\n",
+      "energy_exploded,nan_resets,openings_off_pct\n",
       f.get());
   for (const Row& r : rows) {
     const Setting& s = r.setting;
     std::fprintf(f.get(),
                  "%s,%s,%s,%s,%s,%s,%d,%.4g,%g,%u,%u,%u,%u,%d,%zu,%.4g,"
                  "%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,"
-                 "%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%u,%.5g,%.5g,%d,%u\n",
+                 "%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%u,%.5g,%.5g,%d,%u,%.4g\n",
                  csvText(s.sweep).c_str(), csvText(s.label).c_str(), csvText(r.take).c_str(), solverName(s.solver),
                  responseName(s.contact_response), csvText(s.backend).c_str(), s.is_default ? 1 : 0, r.rate_hz, s.substep_hz,
                  s.iterations, s.ring_points, s.continuous_collision, r.particles, r.repeats, r.timed_frames,
@@ -73,7 +73,8 @@ bool writeRowsCsv(const std::string& path, const std::vector<Row>& rows, std::st
                  r.body.p90, r.proxies.median, r.proxies.p90, r.cloth.median, r.cloth.p90, r.integrate.median,
                  r.integrate.p90, r.collide.median, r.collide.p90, r.ms_per_sim_s, r.dev_rms_mm, r.dev_max_mm,
                  100.0 * r.stretch_p99, 100.0 * r.stretch_max, r.pen_p99_mm, r.pen_max_mm, 100.0 * r.deeper_than_2mm,
-                 r.inside_mean, r.inside_max, r.energy.drift, r.energy.worst, r.energy.exploded ? 1 : 0, r.nan_resets);
+                 r.inside_mean, r.inside_max, r.energy.drift, r.energy.worst, r.energy.exploded ? 1 : 0, r.nan_resets,
+                 100.0 * r.openings_off);
   }
   if (std::ferror(f.get())) {
     error = "error writing " + path;

@@ -31,6 +31,7 @@ struct Row {
   double pen_p99_mm = 0, pen_max_mm = 0, deeper_than_2mm = 0;
   double inside_mean = 0;
   uint32_t inside_max = 0;
+  double openings_off = 0;  // fraction of measured frames with an opening off its body part
   EnergyDrift energy;
   uint32_t nan_resets = 0;
 };

@@ -75,6 +75,7 @@ struct RunResult {
   double penetration_p99_mm = 0, penetration_max_mm = 0, deeper_than_2mm = 0;
   double inside_mean = 0;  // particles inside an ellipsoid, mean per frame
   uint32_t inside_max = 0;
+  double openings_off = 0;  // fraction of measured frames with an opening off its body part
   uint32_t nan_resets = 0;
   // Whole-run substeps per frame (median) as the library reports them.
   double substeps_per_frame = 0;
