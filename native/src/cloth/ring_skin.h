@@ -4,8 +4,9 @@
 // chain in metres. Each point blends every segment nearly as near as its nearest one (weights
 // exp(-(d - d_min) / blend)), so neighbours bound to different chains (armpit, crotch, neck) do
 // not tear apart. Used to retarget OBJ garments onto a body (garment_obj.h) and by garments to
-// place themselves on a body that jumped (first tracked frame, teleport) and to keep particles
-// within a distance of where the body carries them (GarmentSim's skin constraint).
+// place themselves on a body that jumped (first tracked frame, teleport). (A constraint keeping
+// particles within a distance of where the body carries them was tried and not kept:
+// docs/garments.md, "Openings".)
 #pragma once
 
 #include "body/body_model.h"
