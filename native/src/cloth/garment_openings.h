@@ -5,9 +5,9 @@
 //
 // A body part is the polyline through a chain's ring centres (body/body_model.h); the spine runs
 // through the torso's and then the head's rings, and on below the pelvis ring (kSpineExtensionM,
-// away from the waist ring) so that a hem below the hips still goes round it; legs start in the
-// pelvis (kLegExtensionM), arms are not (a sleeve that slides off the shoulder end is
-// off). How much an opening goes round a polyline is their Gauss linking integral: +-1 for a loop
+// away from the waist ring) so that a hem below the hips still goes round it; legs start inside
+// the pelvis (kLegExtensionM); arms start at the shoulder, not extended (a sleeve that slides off
+// the shoulder end is off). How much an opening goes round a polyline is their Gauss linking integral: +-1 for a loop
 // round a line that runs far on both sides, whatever the loop's shape (a crumpled trouser hem
 // round an ankle too), +-1/2 when the loop's centre is at the polyline's end, 0 for a loop beside
 // it. At bind time (the dressed garment on the rest body) every opening records the body part it
@@ -58,7 +58,6 @@ class GarmentOpenings {
   // The same count for positions now (xyz of x[0 .. n)) on `body` (the same ring layout).
   OpeningCount count(const Eigen::Vector4f* x, size_t n, const BodyModel& body) const;
 
-  size_t openingCount() const { return loops_.size(); }
   // The body-part polylines (spine, arms, legs) of `body`: see the file comment.
   static std::vector<std::vector<Vec3>> bodyPolylines(const BodyModel& body);
 
