@@ -149,6 +149,7 @@ struct Series {
   std::vector<double> t;
   std::vector<float> p99, max_stretch, vmax;  // stretch measured on measured frames only (else NaN)
   std::vector<uint32_t> inside;
+  std::vector<int> openings_off;  // drape_garment_accuracy.openings_off on measured frames, else -1
   std::vector<uint8_t> teleport, blend;
   bool finite = true;
   int nan_resets = 0;
@@ -165,6 +166,13 @@ struct Series {
     if (v.empty()) return NAN;
     std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
     return v[v.size() / 2];
+  }
+  // Measured frames with t in [t0, t1] in which an opening was off its body part.
+  int openingsOffFrames(double t0, double t1) const {
+    int n = 0;
+    for (size_t i = 0; i < t.size(); ++i)
+      if (t[i] >= t0 && t[i] <= t1 && openings_off[i] > 0) ++n;
+    return n;
   }
   float maxP99(double t0, double t1) const {
     float m = 0.0f;
@@ -267,6 +275,7 @@ class Scene {
     series.blend.push_back(s.blend_frames > 0 ? 1 : 0);
     float p99 = NAN, mx = NAN;
     uint32_t inside = 0;
+    int off = -1;
     if (measure) {
       drape_garment_accuracy a;
       a.struct_size = sizeof a;
@@ -274,6 +283,7 @@ class Scene {
         p99 = a.p99_stretch;
         mx = a.max_stretch;
         inside = a.proxy_inside;
+        off = static_cast<int>(a.openings_off);
         if (!std::isfinite(a.p99_stretch) || !std::isfinite(a.max_stretch) || !std::isfinite(a.mean_stretch))
           series.finite = false;
         series.inside_total += a.proxy_inside;
@@ -283,6 +293,7 @@ class Scene {
     series.p99.push_back(p99);
     series.max_stretch.push_back(mx);
     series.inside.push_back(inside);
+    series.openings_off.push_back(off);
   }
 
   drape_context* ctx_ = nullptr;
@@ -342,20 +353,26 @@ inline void expectHealthy(const Series& s, const char* what, float speed_bound =
 
 // Recovery: from one second after the disturbance ends, for `window` seconds, the median P99
 // stretch is within `median_margin` of the undisturbed run's over the same window and the worst
-// frame within `worst_margin` of the undisturbed worst. The margins are the noise between runs
+// frame within `worst_margin` of the undisturbed worst, and the garment is as much on the body as
+// in the undisturbed run: no more frames with an opening off its body part (a sleeve the arm left,
+// docs/garments.md "Openings"). The margins are the noise between runs
 // that should agree: the same undisturbed take built at -O1 (ASan) and -O2 differs by 3.4 points
 // of median P99 over one window, and harmless disturbances (1 cm jitter, a lost arm) land 0-5
 // points either side of the undisturbed run (docs/robustness.md).
 inline void expectRecovered(const Series& s, const Series& control, double end, const char* what,
-                            double window = 1.0, float median_margin = 0.06f, float worst_margin = 0.12f) {
+                            double window = 1.0, float median_margin = 0.06f, float worst_margin = 0.12f,
+                            bool openings_back_on = true) {
   const double t0 = end + 1.0, t1 = end + 1.0 + window;
   const float m = s.medianP99(t0, t1), mc = control.medianP99(t0, t1);
   const float w = s.maxP99(t0, t1), wc = control.maxP99(t0, t1);
-  std::printf("[ recovery ] %-34s t %.1f-%.1f s: P99 median %.3f (undisturbed %.3f), worst %.3f (undisturbed %.3f)\n",
-              what, t0, t1, m, mc, w, wc);
+  const int off = s.openingsOffFrames(t0, t1), offc = control.openingsOffFrames(t0, t1);
+  std::printf("[ recovery ] %-34s t %.1f-%.1f s: P99 median %.3f (undisturbed %.3f), worst %.3f (undisturbed %.3f), "
+              "openings off in %d frames (undisturbed %d)\n",
+              what, t0, t1, m, mc, w, wc, off, offc);
   ASSERT_TRUE(std::isfinite(m) && std::isfinite(mc)) << what << ": no measured frame in the recovery window";
   EXPECT_LE(m, mc + median_margin) << what << ": P99 stretch not back to the undisturbed run's one second after";
   EXPECT_LE(w, wc + worst_margin) << what << ": worst P99 one second after the disturbance";
+  if (openings_back_on) EXPECT_LE(off, offc) << what << ": an opening off its body part one second after the disturbance";
 }
 
 }  // namespace stress
