@@ -139,21 +139,16 @@ TEST(CApiGarments, TemplateGarmentFollowsTheBody) {
   EXPECT_EQ(s.device_host_ms, 0.0);
 }
 
-// drape_garment_stats grew the device_* fields; a caller built against the first version (72
-// bytes) still gets its fields and nothing written past them; below that, an error.
-TEST(CApiGarments, StatsOfTheFirstStructVersionAreStillFilled) {
-  ContextPtr ctx = makeContext();
-  drape_garment* g = addTShirt(ctx.get());
-  ASSERT_NE(g, nullptr);
-  for (int i = 0; i < 3; ++i) ASSERT_OK(pushAndStep(ctx.get(), i));
-  drape_garment_stats full;
-  full.struct_size = sizeof(full);
-  ASSERT_OK(drape_garment_get_stats(g, &full));
-  alignas(drape_garment_stats) unsigned char buf[sizeof(drape_garment_stats)];
+// A struct that grew (drape_garment_stats, drape_garment_accuracy): a caller built against its first
+// version (`v1` bytes) still gets those fields, as the full struct has them, and nothing written past
+// them; a struct_size below that is an error that writes nothing. `read` fills the struct at its
+// argument; `full` is the whole struct read the same way.
+template <class Struct, class Read>
+void expectFirstStructVersionFilled(const Struct& full, uint32_t v1, const char* size_field, Read read) {
+  alignas(Struct) unsigned char buf[sizeof(Struct)];
   std::memset(buf, 0xAB, sizeof(buf));
-  const uint32_t v1 = 72;
   std::memcpy(buf, &v1, sizeof(v1));
-  ASSERT_OK(drape_garment_get_stats(g, reinterpret_cast<drape_garment_stats*>(buf)));
+  ASSERT_OK(read(reinterpret_cast<Struct*>(buf)));
   EXPECT_EQ(std::memcmp(buf + sizeof(uint32_t), reinterpret_cast<const unsigned char*>(&full) + sizeof(uint32_t), v1 - sizeof(uint32_t)), 0);
   uint32_t written = 0;
   std::memcpy(&written, buf, sizeof(written));
@@ -162,11 +157,24 @@ TEST(CApiGarments, StatsOfTheFirstStructVersionAreStillFilled) {
   std::memset(buf, 0xAB, sizeof(buf));
   const uint32_t too_small = v1 - 4;
   std::memcpy(buf, &too_small, sizeof(too_small));
-  EXPECT_FAILS(DRAPE_ERROR_INVALID_ARGUMENT, "drape_garment_stats.struct_size",
-               drape_garment_get_stats(g, reinterpret_cast<drape_garment_stats*>(buf)));
+  EXPECT_FAILS(DRAPE_ERROR_INVALID_ARGUMENT, size_field, read(reinterpret_cast<Struct*>(buf)));
   for (size_t k = sizeof(uint32_t); k < sizeof(buf); ++k) ASSERT_EQ(buf[k], 0xAB) << "byte " << k << " written on error";
 }
 
+// drape_garment_stats grew the device_* fields (72 -> 104 bytes).
+TEST(CApiGarments, StatsOfTheFirstStructVersionAreStillFilled) {
+  ContextPtr ctx = makeContext();
+  drape_garment* g = addTShirt(ctx.get());
+  ASSERT_NE(g, nullptr);
+  for (int i = 0; i < 3; ++i) ASSERT_OK(pushAndStep(ctx.get(), i));
+  drape_garment_stats full;
+  full.struct_size = sizeof(full);
+  ASSERT_OK(drape_garment_get_stats(g, &full));
+  expectFirstStructVersionFilled(full, 72, "drape_garment_stats.struct_size",
+                                 [&](drape_garment_stats* out) { return drape_garment_get_stats(g, out); });
+}
+
+// drape_garment_accuracy grew the openings (32 -> 40 bytes).
 TEST(CApiGarments, AccuracyCountsOpeningsAndTheFirstStructVersionIsStillFilled) {
   ContextPtr ctx = makeContext();
   drape_garment* g = addTShirt(ctx.get());
@@ -178,23 +186,8 @@ TEST(CApiGarments, AccuracyCountsOpeningsAndTheFirstStructVersionIsStillFilled) 
   EXPECT_EQ(full.struct_size, 40u);
   EXPECT_EQ(full.openings, 4u);  // hem, collar, two sleeves
   EXPECT_EQ(full.openings_off, 0u);
-  // A caller built against the 32-byte first version: its fields, nothing past them.
-  alignas(drape_garment_accuracy) unsigned char buf[sizeof(drape_garment_accuracy)];
-  std::memset(buf, 0xAB, sizeof(buf));
-  const uint32_t v1 = 32;
-  std::memcpy(buf, &v1, sizeof(v1));
-  ASSERT_OK(drape_garment_measure(g, reinterpret_cast<drape_garment_accuracy*>(buf)));
-  EXPECT_EQ(std::memcmp(buf + sizeof(uint32_t), reinterpret_cast<const unsigned char*>(&full) + sizeof(uint32_t), v1 - sizeof(uint32_t)), 0);
-  uint32_t written = 0;
-  std::memcpy(&written, buf, sizeof(written));
-  EXPECT_EQ(written, v1);
-  for (size_t k = v1; k < sizeof(buf); ++k) ASSERT_EQ(buf[k], 0xAB) << "byte " << k << " written past struct_size";
-  std::memset(buf, 0xAB, sizeof(buf));
-  const uint32_t too_small = v1 - 4;
-  std::memcpy(buf, &too_small, sizeof(too_small));
-  EXPECT_FAILS(DRAPE_ERROR_INVALID_ARGUMENT, "drape_garment_accuracy.struct_size",
-               drape_garment_measure(g, reinterpret_cast<drape_garment_accuracy*>(buf)));
-  for (size_t k = sizeof(uint32_t); k < sizeof(buf); ++k) ASSERT_EQ(buf[k], 0xAB) << "byte " << k << " written on error";
+  expectFirstStructVersionFilled(full, 32, "drape_garment_accuracy.struct_size",
+                                 [&](drape_garment_accuracy* out) { return drape_garment_measure(g, out); });
 }
 
 TEST(CApiGarments, SameInputGivesBitIdenticalGarments) {
