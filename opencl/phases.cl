@@ -131,10 +131,11 @@ __kernel void drape_phase_project(__global const DrapeClGarment* table, uint cou
 /* Consecutive colour groups (rows first_row .. first_row + rows - 1) small enough for one
  * work-group - at most DRAPE_CL_WORK_GROUP items per garment each (the host's choice; the loop
  * below takes any count) - in one launch of one work-group: row after row with a barrier between
- * them, so each row sees the last one's writes as separate launches would, and each constraint runs the same arithmetic in the same order (the
- * same bits). Garments whose colouring has many small groups (a vertex of many edges needs as
- * many colours: the templates' underarm fan, up to 36 edges at 32 000 particles until it was
- * removed, gave ~35 colours per kind) would otherwise pay a launch for each of them. */
+ * them, so each row sees the last one's writes as separate launches would, and each constraint
+ * runs the same arithmetic in the same order (the same bits). Garments whose colouring has many
+ * small groups (a vertex of many edges needs as many colours: the templates' underarm fan, up to
+ * 36 edges at 32 000 particles until it was removed, gave ~35 colours per kind) would otherwise
+ * pay a launch for each of them. */
 __kernel __attribute__((reqd_work_group_size(DRAPE_CL_WORK_GROUP, 1, 1)))
 void drape_phase_project_rows(__global const DrapeClGarment* table, uint count, __global const uint* work,
                               __global float4* x, __global const DrapeClConstraint* constraints,

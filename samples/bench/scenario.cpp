@@ -207,7 +207,7 @@ bool runDrape(const Take& take, const Setting& s, const RunOptions& o, RunResult
   stretch.setMesh(out.indices, out.rest);
   std::vector<drape_vec3> x(nv);
   std::vector<double> inside, substeps;
-  size_t measured_frames = 0, openings_off_frames = 0;
+  size_t openings_off_frames = 0;  // of the measured frames (one `inside` entry each)
   uint32_t refits = 0;
   for (size_t i = 0; i < take.frames.size(); ++i) {
     drape_skeleton_frame f{};
@@ -270,7 +270,6 @@ bool runDrape(const Take& take, const Setting& s, const RunOptions& o, RunResult
             drape_context_read_body_mesh(ctx.get(), body.data(), nullptr, body_nv, nullptr, 0), error))
       return false;
     inside.push_back(acc.proxy_inside);
-    ++measured_frames;
     if (acc.openings_off > 0) ++openings_off_frames;
     out.inside_max = std::max(out.inside_max, acc.proxy_inside);
     if (!pen.setBody(body, body_idx)) {
@@ -288,7 +287,7 @@ bool runDrape(const Take& take, const Setting& s, const RunOptions& o, RunResult
     out.penetration_max_mm = pen.maxMm();
     out.deeper_than_2mm = pen.deeperThan2mmFraction();
     out.inside_mean = mean(inside);
-    out.openings_off = measured_frames > 0 ? static_cast<double>(openings_off_frames) / static_cast<double>(measured_frames) : 0.0;
+    out.openings_off = inside.empty() ? 0.0 : static_cast<double>(openings_off_frames) / static_cast<double>(inside.size());
   }
   return true;
 }

@@ -1,5 +1,5 @@
-// Openings (cloth/garment_openings.h): the boundary loops of a mesh, the linking integral of a loop
-// and a polyline, and every template's openings on the body it was dressed on, then carried off it.
+// Openings (cloth/garment_openings.h): the boundary loops of a mesh (boundaryLoops,
+// cloth/garment_topology.h), the linking integral of a loop and a polyline, and every template's openings on the body it was dressed on, then carried off it.
 #include "cloth/garment_openings.h"
 #include "cloth/garment_solver.h"
 #include "cloth/garment_topology.h"

@@ -180,8 +180,8 @@ TEST(StressBones, ZeroLengthAndReversedBones) {
     std::function<void(Joints&)> f;
     // The garment is back on the body afterwards (recovery window: no more frames with an opening
     // off than the undisturbed run). Not yet after a zero-length spine: from its first frame (P99
-    // stretch 151 %) one opening stays off to the end of the take, P99 0.19-0.22 against 0.17
-    // (docs/robustness.md, "Openings after a disturbance").
+    // stretch 151 %) one opening stays off to the end of the take; recovery-window median P99 0.21
+    // against 0.17 (docs/robustness.md, "Openings after a disturbance").
     bool stays_on = true;
   };
   const Case cases[] = {

@@ -3,6 +3,7 @@
 #include "cloth/garment_obj.h"
 
 #include "body/body_shape.h"
+#include "cloth/garment_topology.h"
 #include "cloth/ring_skin.h"
 
 #include <algorithm>
@@ -266,39 +267,13 @@ SkeletonPose sourcePose(const ResolvedShape& shape, const ObjFitParams& p) {
   return pose;
 }
 
-// For each connected component, the loop to pin (empty when none): among the boundary loops, the
-// highest (mean source y) whose vertices are mostly bound to the Torso or Head chain and which
-// winds once around that chain's axis. Boundary edges (used by one triangle) are walked as an
-// undirected graph: the elegant suit's lapel has a flipped face beside a pinch vertex, which
-// breaks a walk along face directions.
+// For each connected component, the loop to pin (empty when none): among the boundary loops
+// (boundaryLoops, cloth/garment_topology.h: walked as an undirected graph, since the elegant suit's
+// lapel has a flipped face beside a pinch vertex), the highest (mean source y) whose vertices are
+// mostly bound to the Torso or Head chain and which winds once around that chain's axis.
 std::vector<std::vector<uint32_t>> attachmentLoops(const std::vector<uint32_t>& I, const std::vector<Vec3>& src,
                                                    const std::vector<RingBinding>& primary) {
   const size_t nv = src.size();
-  std::vector<uint64_t> keys;
-  keys.reserve(I.size());
-  for (size_t t = 0; t < I.size(); t += 3) {
-    for (int k = 0; k < 3; ++k) {
-      const uint64_t a = I[t + k], b = I[t + (k + 1) % 3];
-      keys.push_back(std::min(a, b) << 32 | std::max(a, b));
-    }
-  }
-  std::sort(keys.begin(), keys.end());
-  std::vector<uint64_t> edges, ends;  // boundary edges; (vertex << 32 | edge id) for both ends
-  for (size_t i = 0, j = 0; i < keys.size(); i = j) {
-    while (j < keys.size() && keys[j] == keys[i]) ++j;
-    if (j - i > 1) continue;
-    ends.push_back((keys[i] >> 32) << 32 | edges.size());
-    ends.push_back((keys[i] & 0xffffffffu) << 32 | edges.size());
-    edges.push_back(keys[i]);
-  }
-  std::sort(ends.begin(), ends.end());
-  std::vector<char> used(edges.size(), 0);
-  const auto nextEdge = [&](uint64_t v) -> size_t {
-    for (auto it = std::lower_bound(ends.begin(), ends.end(), v << 32); it != ends.end() && (*it >> 32) == v; ++it) {
-      if (!used[*it & 0xffffffffu]) return *it & 0xffffffffu;
-    }
-    return edges.size();
-  };
   std::vector<uint32_t> parent(nv);
   for (uint32_t i = 0; i < nv; ++i) parent[i] = i;
   const auto find = [&](uint32_t a) {
@@ -311,21 +286,7 @@ std::vector<std::vector<uint32_t>> attachmentLoops(const std::vector<uint32_t>& 
   }
   std::vector<std::vector<uint32_t>> chosen(nv);  // indexed by component root
   std::vector<float> chosenY(nv, -std::numeric_limits<float>::infinity());
-  std::vector<uint32_t> loop;
-  for (size_t h = 0; h < edges.size(); ++h) {
-    if (used[h]) continue;
-    used[h] = 1;
-    const uint64_t start = edges[h] >> 32;
-    uint64_t cur = edges[h] & 0xffffffffu;
-    loop.assign(1, static_cast<uint32_t>(start));
-    while (cur != start) {
-      loop.push_back(static_cast<uint32_t>(cur));
-      const size_t e = nextEdge(cur);
-      if (e == edges.size()) break;  // an open chain (odd-degree vertex): not a loop
-      used[e] = 1;
-      cur = (edges[e] >> 32) == cur ? edges[e] & 0xffffffffu : edges[e] >> 32;
-    }
-    if (cur != start || loop.size() < 3) continue;
+  for (const std::vector<uint32_t>& loop : boundaryLoops(I, nv)) {
     size_t onTrunk = 0;
     float turn = 0.0f, meanY = 0.0f;
     for (size_t i = 0; i < loop.size(); ++i) {

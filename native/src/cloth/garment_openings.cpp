@@ -1,46 +1,11 @@
 #include "cloth/garment_openings.h"
+#include "cloth/garment_topology.h"
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <utility>
 
 namespace drape {
-
-std::vector<std::vector<uint32_t>> boundaryLoops(const std::vector<uint32_t>& triangles, size_t vertex_count) {
-  // Undirected edge -> uses; a boundary edge keeps the direction its one triangle gives it, so
-  // every loop runs the same way round relative to the surface.
-  std::map<std::pair<uint32_t, uint32_t>, int> uses;
-  for (size_t t = 0; t + 2 < triangles.size(); t += 3)
-    for (int e = 0; e < 3; ++e) {
-      const uint32_t i = triangles[t + static_cast<size_t>(e)], j = triangles[t + static_cast<size_t>((e + 1) % 3)];
-      if (i == j || i >= vertex_count || j >= vertex_count) continue;
-      ++uses[{std::min(i, j), std::max(i, j)}];
-    }
-  std::multimap<uint32_t, uint32_t> next;  // boundary half-edges i -> j
-  for (size_t t = 0; t + 2 < triangles.size(); t += 3)
-    for (int e = 0; e < 3; ++e) {
-      const uint32_t i = triangles[t + static_cast<size_t>(e)], j = triangles[t + static_cast<size_t>((e + 1) % 3)];
-      if (i == j || i >= vertex_count || j >= vertex_count) continue;
-      if (uses[{std::min(i, j), std::max(i, j)}] == 1) next.emplace(i, j);
-    }
-  std::vector<std::vector<uint32_t>> loops;
-  while (!next.empty()) {
-    const uint32_t first = next.begin()->first;
-    std::vector<uint32_t> loop{first};
-    uint32_t at = first;
-    for (;;) {
-      const auto it = next.find(at);
-      if (it == next.end()) break;  // an open chain (non-manifold input): dropped below
-      at = it->second;
-      next.erase(it);
-      if (at == first) break;
-      loop.push_back(at);
-    }
-    if (at == first && loop.size() >= 3) loops.push_back(std::move(loop));
-  }
-  return loops;
-}
 
 namespace {
 
@@ -108,46 +73,39 @@ std::vector<std::vector<Vec3>> GarmentOpenings::bodyPolylines(const BodyModel& b
 
 void GarmentOpenings::bind(const std::vector<uint32_t>& triangles, const std::vector<Vec3>& positions,
                            const BodyModel& body_rest) {
-  loops_ = boundaryLoops(triangles, positions.size());
-  pairs_.clear();
+  openings_.clear();
   const std::vector<std::vector<Vec3>> parts = bodyPolylines(body_rest);
-  std::vector<Vec3> loop;
-  for (size_t l = 0; l < loops_.size(); ++l) {
-    loop.clear();
-    for (uint32_t i : loops_[l]) loop.push_back(positions[i]);
+  std::vector<Vec3> at;
+  for (std::vector<uint32_t>& loop : boundaryLoops(triangles, positions.size())) {
+    at.clear();
+    for (uint32_t i : loop) at.push_back(positions[i]);
     // The body part it goes round most (the spine for a hem round the hips and both legs).
     float best = 0.0f;
-    size_t best_part = 0;
+    uint32_t best_part = 0;
     for (size_t p = 0; p < parts.size(); ++p) {
-      const float linking = loopLinking(loop, parts[p]);
+      const float linking = loopLinking(at, parts[p]);
       if (std::fabs(linking) > std::fabs(best)) {
         best = linking;
-        best_part = p;
+        best_part = static_cast<uint32_t>(p);
       }
     }
-    if (std::fabs(best) >= kBindLinking)
-      pairs_.push_back({static_cast<uint32_t>(l), static_cast<uint32_t>(best_part), best > 0.0f ? 1 : -1});
+    if (std::fabs(best) >= kBindLinking) openings_.push_back({std::move(loop), best_part, best > 0.0f ? 1 : -1});
   }
 }
 
 OpeningCount GarmentOpenings::count(const Eigen::Vector4f* x, size_t n, const BodyModel& body) const {
   OpeningCount c;
-  c.tracked = static_cast<uint32_t>(pairs_.size());
-  if (pairs_.empty()) return c;
+  c.tracked = static_cast<uint32_t>(openings_.size());
+  if (openings_.empty()) return c;
   const std::vector<std::vector<Vec3>> parts = bodyPolylines(body);
-  std::vector<Vec3> loop;
-  for (const Pair& pair : pairs_) {
-    loop.clear();
-    bool in_range = true;
-    for (uint32_t i : loops_[pair.loop]) {
-      if (i >= n) {
-        in_range = false;
-        break;
-      }
-      loop.push_back(x[i].head<3>());
-    }
-    const float linking = in_range && pair.polyline < parts.size() ? loopLinking(loop, parts[pair.polyline]) : 0.0f;
-    if (!(linking * static_cast<float>(pair.sign) >= kOffLinking)) ++c.off;
+  std::vector<Vec3> at;
+  for (const Opening& o : openings_) {
+    at.clear();
+    for (uint32_t i : o.loop)
+      if (i < n) at.push_back(x[i].head<3>());
+    const bool whole = at.size() == o.loop.size() && o.part < parts.size();
+    const float linking = whole ? loopLinking(at, parts[o.part]) : 0.0f;
+    if (!(linking * static_cast<float>(o.sign) >= kOffLinking)) ++c.off;
   }
   return c;
 }

@@ -26,11 +26,6 @@
 
 namespace drape {
 
-// The closed boundary loops of a triangle mesh, each in order along the loop. Edges used by one
-// triangle are boundary edges; a vertex where boundary loops touch (two boundary edges in and
-// two out) ends up in each loop that passes it. Loops shorter than three vertices are dropped.
-std::vector<std::vector<uint32_t>> boundaryLoops(const std::vector<uint32_t>& triangles, size_t vertex_count);
-
 // Gauss linking integral of the closed loop (last vertex joined to the first) and the open
 // polyline: the sum over segment pairs of the signed solid angle, over 4 pi.
 float loopLinking(const std::vector<Vec3>& loop, const std::vector<Vec3>& polyline);
@@ -52,8 +47,9 @@ class GarmentOpenings {
   // (a T-shirt's, a skirt's) stays round them when the thigh ring moves past it.
   static constexpr float kLegExtensionM = 0.15f;
 
-  // The openings of `triangles` and the body part each goes round with the garment at `positions`
-  // on `body_rest` (a BodyModel updated with its rest pose).
+  // The openings of `triangles` (boundaryLoops, cloth/garment_topology.h) and the body part each
+  // goes round with the garment at `positions` on `body_rest` (a BodyModel updated with its rest
+  // pose).
   void bind(const std::vector<uint32_t>& triangles, const std::vector<Vec3>& positions, const BodyModel& body_rest);
   // The same count for positions now (xyz of x[0 .. n)) on `body` (the same ring layout).
   OpeningCount count(const Eigen::Vector4f* x, size_t n, const BodyModel& body) const;
@@ -62,13 +58,12 @@ class GarmentOpenings {
   static std::vector<std::vector<Vec3>> bodyPolylines(const BodyModel& body);
 
  private:
-  struct Pair {  // an opening and its body part
-    uint32_t loop;
-    uint32_t polyline;
-    int sign;  // of the linking at rest
+  struct Opening {
+    std::vector<uint32_t> loop;  // particle indices round the loop
+    uint32_t part;               // index into bodyPolylines()
+    int sign;                    // of the linking at rest
   };
-  std::vector<std::vector<uint32_t>> loops_;
-  std::vector<Pair> pairs_;
+  std::vector<Opening> openings_;  // the tracked ones only
 };
 
 }  // namespace drape

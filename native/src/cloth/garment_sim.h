@@ -16,10 +16,10 @@
 
 #include "body/body_model.h"
 #include "cloth/cloth_stats.h"
+#include "cloth/garment_openings.h"
 #include "cloth/garment_templates.h"
 #include "cloth/garment_topology.h"
 #include "cloth/mass_spring_solver.h"
-#include "cloth/garment_openings.h"
 #include "cloth/ring_skin.h"
 #include "cloth/xpbd_solver.h"
 #include "proxies/collision.h"

@@ -241,6 +241,53 @@ bool buildGarmentTopology(const float* positions, size_t vertex_count, const uin
   return true;
 }
 
+std::vector<std::vector<uint32_t>> boundaryLoops(const std::vector<uint32_t>& triangles, size_t vertex_count) {
+  std::vector<uint64_t> keys;
+  keys.reserve(triangles.size());
+  for (size_t t = 0; t + 2 < triangles.size(); t += 3) {
+    if (triangles[t] >= vertex_count || triangles[t + 1] >= vertex_count || triangles[t + 2] >= vertex_count) continue;
+    for (size_t k = 0; k < 3; ++k) {
+      const uint64_t a = triangles[t + k], b = triangles[t + (k + 1) % 3];
+      if (a != b) keys.push_back(std::min(a, b) << 32 | std::max(a, b));
+    }
+  }
+  std::sort(keys.begin(), keys.end());
+  std::vector<uint64_t> edges, ends;  // boundary edges; (vertex << 32 | edge id) for both ends
+  for (size_t i = 0, j = 0; i < keys.size(); i = j) {
+    while (j < keys.size() && keys[j] == keys[i]) ++j;
+    if (j - i > 1) continue;
+    ends.push_back((keys[i] >> 32) << 32 | edges.size());
+    ends.push_back((keys[i] & 0xffffffffu) << 32 | edges.size());
+    edges.push_back(keys[i]);
+  }
+  std::sort(ends.begin(), ends.end());
+  std::vector<char> used(edges.size(), 0);
+  const auto nextEdge = [&](uint64_t v) -> size_t {
+    for (auto it = std::lower_bound(ends.begin(), ends.end(), v << 32); it != ends.end() && (*it >> 32) == v; ++it) {
+      if (!used[*it & 0xffffffffu]) return *it & 0xffffffffu;
+    }
+    return edges.size();
+  };
+  std::vector<std::vector<uint32_t>> loops;
+  std::vector<uint32_t> loop;
+  for (size_t h = 0; h < edges.size(); ++h) {
+    if (used[h]) continue;
+    used[h] = 1;
+    const uint64_t start = edges[h] >> 32;
+    uint64_t cur = edges[h] & 0xffffffffu;
+    loop.assign(1, static_cast<uint32_t>(start));
+    while (cur != start) {
+      loop.push_back(static_cast<uint32_t>(cur));
+      const size_t e = nextEdge(cur);
+      if (e == edges.size()) break;  // an open chain (odd-degree vertex): not a loop
+      used[e] = 1;
+      cur = (edges[e] >> 32) == cur ? edges[e] & 0xffffffffu : edges[e] >> 32;
+    }
+    if (cur == start && loop.size() >= 3) loops.push_back(loop);
+  }
+  return loops;
+}
+
 void makeClothGrid(int nx, int ny, float width, float height, const Vec3& origin, const Vec3& u,
                    const Vec3& v, std::vector<float>& positions, std::vector<uint32_t>& indices) {
   positions.clear();

@@ -66,6 +66,14 @@ bool buildGarmentTopology(const float* positions, size_t vertex_count, const uin
                           size_t index_count, const TopologyParams& params, GarmentTopology& out,
                           std::string& error);
 
+// The closed boundary loops of a triangle mesh, each in order along the loop (its direction is
+// the walk's, not the faces'). Boundary edges (used by one triangle) are walked as an undirected
+// graph, so a flipped face beside a pinch vertex (the MakeHuman elegant suit's lapel) does not
+// break a loop; an open chain (an odd-degree vertex) is no loop and is dropped, as are loops of
+// fewer than three vertices. Triangles with an index >= vertex_count and degenerate edges are
+// ignored. Loops come in the order of their first edge, (min, max) index pairs sorted.
+std::vector<std::vector<uint32_t>> boundaryLoops(const std::vector<uint32_t>& triangles, size_t vertex_count);
+
 // Greedy deterministic colouring: constraints are visited in order, each takes the smallest colour
 // used by none of its particles (only `a` when `colour_b` is false); the set is then stably sorted
 // by colour and colour_offsets filled. Exposed for tests.
