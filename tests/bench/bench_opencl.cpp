@@ -138,11 +138,11 @@ void BM_BackendGarmentFrame(benchmark::State& state) {
 }
 
 void backendArgs(benchmark::internal::Benchmark* b) {
-  for (int particles : {2000, 8000, 32000, 128000})
+  for (int particles : {2000, 4000, 8000, 32000, 128000})
     for (int collide : {1, 0}) {
       for (int backend : {0, 1}) b->Args({backend, particles, collide, 0});
       if (particles >= 8000 && particles <= 32000) b->Args({1, particles, collide, 1});  // work-group forced
-      if (particles == 2000) b->Args({1, particles, collide, 2});  // per-phase launches forced
+      if (particles <= 4000) b->Args({1, particles, collide, 2});  // per-phase launches forced
     }
 }
 BENCHMARK(BM_BackendGarmentFrame)->Apply(backendArgs)->ArgNames({"opencl", "particles", "collide", "path"})

@@ -18,4 +18,12 @@ for f in .gpu/bin/*; do
 done | sort -u | grep -Ev '/(libc|libm|libpthread|libdl|librt|libstdc\+\+|libgcc_s|ld-linux[^/]*)\.so' |
   while read -r lib; do cp -L "$lib" .gpu/lib/; done
 strip --strip-debug .gpu/bin/* .gpu/lib/* 2>/dev/null || true
+# The data the OpenCL tests read (the Kinect takes, 0.7 MB; the tests skip without them), from
+# ../shared beside the checkout when it is there: the device tool carries the checkout alone.
+shared="$root/../shared/data"
+if [[ -d "$shared/kinect_v2_msft_labanotation" ]]; then
+  mkdir -p .gpu/shared/data && cp -r "$shared/kinect_v2_msft_labanotation" .gpu/shared/data/
+else
+  echo "pack.sh: $shared not found; the OpenCL tests on the Kinect takes will skip on the device"
+fi
 du -sh .gpu

@@ -34,13 +34,13 @@ for p in 2000 32000; do
     for v in "${versions[@]}"; do
       for be in opencl cpu; do
         [[ "$be" == cpu && ( "$rep" != 1 || "$v" != .gpu ) ]] && continue
-        timeout 60 bash -c "$(declare -f run); run $v drape-replay --backend $be --particles $p --no-obj --no-render \
+        timeout 60 bash -c "$(declare -f run); run $v drape-replay --recording samples/data/Ges01_wavehand.csv --backend $be --particles $p --no-obj --no-render \
           --measure-every 0 --fidelity-every 0 -q --stats /tmp/r.json" >/dev/null 2>&1
         echo "$v $be particles $p run $rep: $(median /tmp/r.json)" | tee -a "$out/replay.txt"
       done
     done
   done
-  timeout 60 bash -c "$(declare -f run); run .gpu drape-replay --backend opencl --particles $p --full-pipeline --no-obj \
+  timeout 60 bash -c "$(declare -f run); run .gpu drape-replay --recording samples/data/Ges01_wavehand.csv --backend opencl --particles $p --full-pipeline --no-obj \
     --no-render --measure-every 0 --fidelity-every 0 -q --stats /tmp/r.json" >/dev/null 2>&1
   echo ".gpu opencl particles $p --full-pipeline: $(median /tmp/r.json)" | tee -a "$out/replay.txt"
 done
