@@ -2,17 +2,20 @@
 # Builds everything and runs every test: native GoogleTest suites through CTest (C header, ABI
 # symbol list, samples, stress scenarios, fuzz regressions included) and the C# xunit tests against
 # the same native build; then the native suite again under AddressSanitizer + UndefinedBehavior-
-# Sanitizer, and a bounded run of each libFuzzer target (docs/robustness.md).
+# Sanitizer (clang), and a bounded run of each libFuzzer target, built in that same sanitizer tree
+# (docs/robustness.md).
 # Environment: DRAPE_SKIP_ASAN=1 / DRAPE_SKIP_FUZZ=1 skip those stages; DRAPE_FUZZ_SECONDS sets
 # the wall time of the fuzz targets, which run side by side (default 30: on two cores each gets
 # about 20 s of CPU).
 #
 # Time (docs/robustness.md, "CI time"): CI runs on 2 cores, and the stages are CPU-bound, so the
-# savings come from less compiling (the sanitizer presets use line tables instead of full debug
-# info, precompiled headers and unity batches of the test files: cmake/sanitizer_build_speed.cmake)
-# and from filling the cores the serial stages leave idle: the ASan tree builds in the background
-# while the release tests, `dotnet test` and Mono run (each has a single-threaded tail), and the
-# three fuzz targets share the cores instead of taking turns on one.
+# savings come from less compiling and from filling the cores the serial stages leave idle. Less
+# compiling: one clang sanitizer tree gives both the ASan + UBSan tests and the libFuzzer targets
+# (a gcc tree and a clang tree were built before, and clang compiles the instrumented Eigen code
+# faster), with line tables instead of full debug info, precompiled headers and unity batches of
+# the test files (cmake/sanitizer_build_speed.cmake). Idle cores: the sanitizer tree builds in the
+# background while the release tests, `dotnet test` and Mono run (each has a single-threaded
+# tail), and the three fuzz targets share the cores instead of taking turns on one.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root"

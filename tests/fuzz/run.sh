@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets (preset `fuzz`: clang-15, ASan + UBSan) and runs each one for a
-# bounded time on its seed corpus (generated from ../shared/data by the build) plus what earlier
-# runs found. Any crash, sanitizer report, leak or timeout fails the script; the input is left in
-# build/fuzz/artifacts/<target>/ - add it to tests/fuzz/regressions/<target>/ with the fix.
+# Builds the libFuzzer targets (clang-15, ASan + UBSan: in the `asan` preset's tree, which CI has
+# already built for the sanitizer tests, or with DRAPE_FUZZ_PRESET=fuzz in a tree of their own at
+# -O2, which runs them faster) and runs each one for a bounded time on its seed corpus (generated
+# from ../shared/data by the build) plus what earlier runs found. Any crash, sanitizer report,
+# leak or timeout fails the script; the input is left in build/<preset>/artifacts/<target>/ - add
+# it to tests/fuzz/regressions/<target>/ with the fix.
 #
 #   bash tests/fuzz/run.sh [seconds per target, default 30] [target ...]
-#   bash tests/fuzz/run.sh 3600 capi        # the longer run documented in docs/robustness.md
+#   DRAPE_FUZZ_PRESET=fuzz bash tests/fuzz/run.sh 3600 capi   # a longer run (docs/robustness.md)
 # Environment: DRAPE_FUZZ_JOBS (parallel jobs per target, default 1), DRAPE_FUZZ_ARGS (extra
 # libFuzzer flags).
 # The targets run side by side, each for the given wall time (on 2 cores, 30 s side by side is
@@ -20,19 +22,21 @@ shift || true
 targets=("$@")
 ((${#targets[@]})) || targets=(recording obj capi)
 
-cmake --preset fuzz >/dev/null
-cmake --build --preset fuzz -j"$(nproc)"
+preset="${DRAPE_FUZZ_PRESET:-asan}"
+tree="$root/build/$preset"
+[[ -f "$tree/CMakeCache.txt" ]] || cmake --preset "$preset" >/dev/null
+cmake --build "$tree" -j"$(nproc)" --target drape_fuzz_seeds "${targets[@]/#/drape_fuzz_}"
 
-build="$root/build/fuzz/tests/fuzz"
-cd "$root/build/fuzz"   # libFuzzer -jobs writes fuzz-<n>.log into the working directory
+build="$tree/tests/fuzz"
+cd "$tree"   # libFuzzer -jobs writes fuzz-<n>.log into the working directory
 side_by_side="${DRAPE_FUZZ_SIDE_BY_SIDE:-1}"
 if ((${DRAPE_FUZZ_JOBS:-1} > 1)); then side_by_side=0; fi
 
-# Fuzzes one target; its output goes to build/fuzz/fuzz_<target>.log. Returns libFuzzer's status.
+# Fuzzes one target; its output goes to build/<preset>/fuzz_<target>.log. Returns libFuzzer's status.
 fuzz_target() {
   local t="$1"
-  local corpus="$root/build/fuzz/corpus/$t"      # grows across runs (not committed)
-  local artifacts="$root/build/fuzz/artifacts/$t"
+  local corpus="$tree/corpus/$t"      # grows across runs (not committed)
+  local artifacts="$tree/artifacts/$t"
   mkdir -p "$corpus" "$artifacts"
   local dirs=("$corpus" "$build/seeds/$t")
   # Committed crash inputs (git keeps no empty folder, so it may be absent).
@@ -55,12 +59,12 @@ fuzz_target() {
     "$build/drape_fuzz_$t" "${dirs[@]}" \
       -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len="$max_len" "${jobs[@]}" \
       -artifact_prefix="$artifacts/" -print_final_stats=1 ${DRAPE_FUZZ_ARGS:-} \
-      >"$root/build/fuzz/fuzz_$t.log" 2>&1
+      >"$tree/fuzz_$t.log" 2>&1
 }
 
 # Reports one finished target: its statistics, or the end of its log when it failed.
 report_target() {
-  local t="$1" rc="$2" log="$root/build/fuzz/fuzz_$1.log"
+  local t="$1" rc="$2" log="$tree/fuzz_$1.log"
   if ((rc != 0)); then
     echo "drape: fuzz_$t FAILED (exit $rc); the last lines of $log:" >&2
     tail -40 "$log" >&2

@@ -89,7 +89,12 @@ extern "C" {
 DRAPE_API const char* DRAPE_CALL drape_last_error(void) { return drape::api::lastError(); }
 
 DRAPE_API const char* DRAPE_CALL drape_result_name(drape_result result) {
-  switch (result) {
+  // A C caller may pass any int here, and in C++ reading an enum object that holds a value outside
+  // the enum's range is undefined (clang's UBSan reports it): the code is read as its bytes.
+  int32_t code = 0;
+  static_assert(sizeof(result) == sizeof(code), "drape_result is int-sized in C and C++");
+  std::memcpy(&code, &result, sizeof(code));
+  switch (code) {
     case DRAPE_OK: return "DRAPE_OK";
     case DRAPE_ERROR_NULL_ARGUMENT: return "DRAPE_ERROR_NULL_ARGUMENT";
     case DRAPE_ERROR_INVALID_ARGUMENT: return "DRAPE_ERROR_INVALID_ARGUMENT";

@@ -34,14 +34,19 @@ inline int lowestBit(uint64_t m) {
 }
 
 // Box tests with & rather than &&: no branch per comparison (random particle data mispredicts).
+// The comparisons are combined as integers so that no compiler takes the & for a mistyped &&.
 inline bool containsPoint(const Vec3& mn, const Vec3& mx, const Vec3& p) {
-  return (p.x() >= mn.x()) & (p.x() <= mx.x()) & (p.y() >= mn.y()) & (p.y() <= mx.y()) &
-         (p.z() >= mn.z()) & (p.z() <= mx.z());
+  const unsigned inside = unsigned(p.x() >= mn.x()) & unsigned(p.x() <= mx.x()) &
+                          unsigned(p.y() >= mn.y()) & unsigned(p.y() <= mx.y()) &
+                          unsigned(p.z() >= mn.z()) & unsigned(p.z() <= mx.z());
+  return inside != 0u;
 }
 
 inline bool overlaps(const Vec3& lo, const Vec3& hi, const Vec3& mn, const Vec3& mx) {
-  return (lo.x() <= mx.x()) & (hi.x() >= mn.x()) & (lo.y() <= mx.y()) & (hi.y() >= mn.y()) &
-         (lo.z() <= mx.z()) & (hi.z() >= mn.z());
+  const unsigned overlap = unsigned(lo.x() <= mx.x()) & unsigned(hi.x() >= mn.x()) &
+                           unsigned(lo.y() <= mx.y()) & unsigned(hi.y() >= mn.y()) &
+                           unsigned(lo.z() <= mx.z()) & unsigned(hi.z() >= mn.z());
+  return overlap != 0u;
 }
 
 // Cell coordinates of a point (4-wide: the w lane is ignored), clamped to the grid. Monotone in
