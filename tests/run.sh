@@ -12,10 +12,11 @@
 # savings come from less compiling and from filling the cores the serial stages leave idle. Less
 # compiling: one clang sanitizer tree gives both the ASan + UBSan tests and the libFuzzer targets
 # (a gcc tree and a clang tree were built before, and clang compiles the instrumented Eigen code
-# faster), with line tables instead of full debug info, precompiled headers and unity batches of
-# the test files (cmake/sanitizer_build_speed.cmake). Idle cores: the sanitizer tree builds in the
-# background while the release tests, `dotnet test` and Mono run (each has a single-threaded
-# tail), and the three fuzz targets share the cores instead of taking turns on one.
+# faster), with line tables instead of full debug info and precompiled headers; the test files
+# compile in unity batches with precompiled headers in both trees (cmake/ci_build_speed.cmake).
+# Idle cores: the sanitizer tree builds in the background while the release tests, `dotnet test`
+# and Mono run (each has a single-threaded tail), and the three fuzz targets share the cores
+# instead of taking turns on one.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root"
