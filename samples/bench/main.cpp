@@ -183,7 +183,7 @@ struct Runner {
     Setting ref_key_setting = s;
     ref_key_setting.substep_hz = s.solver == DRAPE_SOLVER_MASS_SPRING ? kMassSpringSubstepHz : Setting{}.substep_hz;
     ref_key_setting.iterations = 1;
-    const Setting ref = ref_key_setting.reference();
+    const Setting ref = ref_key_setting.reference(opt.quick);
     const std::string ref_id = ref.key() + "|" + take.name;
     if (!references.count(ref_id)) {
       RunResult rr;
