@@ -138,10 +138,18 @@ void BM_BackendGarmentFrame(benchmark::State& state) {
 }
 
 void backendArgs(benchmark::internal::Benchmark* b) {
+  // 500-2 600 (collision on): where the one work-group frame and the per-phase launches both fit
+  // a GPU's local memory, each forced, to price Auto's choice between them on a GPU.
+  for (int particles : {500, 1000, 1400, 2600}) {
+    b->Args({0, particles, 1, 0});
+    b->Args({1, particles, 1, 1});
+    b->Args({1, particles, 1, 2});
+  }
   for (int particles : {2000, 4000, 8000, 32000, 128000})
     for (int collide : {1, 0}) {
       for (int backend : {0, 1}) b->Args({backend, particles, collide, 0});
-      if (particles >= 8000 && particles <= 32000) b->Args({1, particles, collide, 1});  // work-group forced
+      if ((particles >= 8000 && particles <= 32000) || (particles == 2000 && collide == 1))
+        b->Args({1, particles, collide, 1});  // work-group forced
       if (particles <= 4000) b->Args({1, particles, collide, 2});  // per-phase launches forced
     }
 }

@@ -432,6 +432,40 @@ TEST(OpenClKernels, PhaseLaunchesMatchTheWorkGroupFrameBitForBit) {
   }
   EXPECT_GT(solvers[0]->lastCollisionStats().tests, 0u);
 }
+
+// The automatic path: one work-group up to the device's limit (what fits in __local memory, 4 096
+// particles on a CPU device such as PoCL, 1 200 on a GPU, where the per-phase launches win from
+// ~1 120 particles with collision: docs/opencl.md, "Fifth lease"), the per-phase launches above.
+TEST(OpenClKernels, AutomaticPathSwitchesAtTheDeviceLimit) {
+  DRAPE_REQUIRE_OPENCL(rt);
+  const size_t limit = rt->workGroupMaxParticles();
+  EXPECT_EQ(limit, std::min(rt->localParticles(), rt->isGpu() ? ClRuntime::kGpuWorkGroupMaxParticles
+                                                               : ClRuntime::kWorkGroupMaxParticles));
+  const cl_device_type type = [&] {
+    cl_device_type t = 0;
+    clGetDeviceInfo(rt->device(), CL_DEVICE_TYPE, sizeof t, &t, nullptr);
+    return t;
+  }();
+  EXPECT_EQ(rt->isGpu(), (type & CL_DEVICE_TYPE_GPU) != 0) << rt->deviceName();
+  // Square grids of side floor(sqrt(limit)) (at most the limit) and one more (over it).
+  size_t side = 1;
+  while ((side + 1) * (side + 1) <= limit) ++side;
+  for (const size_t n : {side, side + 1}) {
+    std::vector<float> positions;
+    std::vector<uint32_t> indices;
+    const int k = static_cast<int>(n);
+    makeClothGrid(k, k, 1.0f, 1.0f, Vec3(-0.5f, 0.0f, -0.5f), Vec3::UnitX(), Vec3::UnitZ(), positions, indices);
+    TopologyParams tp;
+    tp.pinned = {0, static_cast<uint32_t>(n - 1)};
+    GarmentTopology t;
+    std::string err;
+    ASSERT_TRUE(buildGarmentTopology(positions.data(), positions.size() / 3, indices.data(), indices.size(), tp, t, err));
+    auto s = ClXpbdSolver::create(rt, t, {}, {}, err);
+    ASSERT_TRUE(s) << err;
+    EXPECT_EQ(s->usesPhases(), n * n > limit) << n * n << " particles, limit " << limit << " on " << rt->deviceName();
+    EXPECT_EQ(s->usesLocalMemory(), n * n <= limit);
+  }
+}
 #endif
 }  // namespace
 }  // namespace drape

@@ -233,6 +233,9 @@ bool ClRuntime::build(const ClChoice& choice, std::string& err) {
   work_group_ = std::max<size_t>(1, std::min<size_t>(256, max_wg));
   const cl_ulong local = deviceValue<cl_ulong>(device_, CL_DEVICE_LOCAL_MEM_SIZE);
   local_particles_ = local > 4096 ? std::min<size_t>(65536, static_cast<size_t>((local - 4096) / 16)) : 1;
+  gpu_ = (deviceValue<cl_device_type>(device_, CL_DEVICE_TYPE) & CL_DEVICE_TYPE_GPU) != 0;
+  work_group_max_particles_ =
+      std::min(local_particles_, gpu_ ? kGpuWorkGroupMaxParticles : kWorkGroupMaxParticles);
 
   // The program: the sources in their fixed order, the frame body twice (local, global).
   std::string source;

@@ -60,6 +60,19 @@ class ClRuntime {
   bool profiling() const { return profiling_; }
   // Particles one work-group keeps in __local memory (DRAPE_CL_MAX_LOCAL_PARTICLES).
   size_t localParticles() const { return local_particles_; }
+  // A GPU (CL_DEVICE_TYPE_GPU), not a CPU or accelerator device such as PoCL's.
+  bool isGpu() const { return gpu_; }
+  // The largest garment the automatic path runs as one work-group frame (cl_xpbd_solver.h,
+  // ClXpbdSolver::Path): what fits in __local memory, at most kWorkGroupMaxParticles, and on a GPU
+  // at most kGpuWorkGroupMaxParticles. One work-group runs on one of a GPU's compute units, so
+  // its frame grows with the garment, while the per-phase launches spread over all of them for a
+  // launch cost that hardly depends on the size. On an H100 (docs/opencl.md, "Fifth lease",
+  // BM_BackendGarmentFrame with collision, medians of 5) the work-group frame took 1.45 ms at 885
+  // particles against 1.73 for the phases, and 2.23 against 1.61 at 1 810; the lines cross near
+  // 1 120. On PoCL (the CPU as the device) the phases only win from ~7 800 particles: 4 096 there.
+  static constexpr size_t kWorkGroupMaxParticles = 4096;
+  static constexpr size_t kGpuWorkGroupMaxParticles = 1200;
+  size_t workGroupMaxParticles() const { return work_group_max_particles_; }
   size_t workGroup() const { return work_group_; }
   double buildMs() const { return build_ms_; }
 
@@ -87,7 +100,8 @@ class ClRuntime {
   cl_program program_ = nullptr;
   bool profiling_ = false;
   std::string device_name_, platform_name_;
-  size_t local_particles_ = 1, work_group_ = 64;
+  size_t local_particles_ = 1, work_group_ = 64, work_group_max_particles_ = 1;
+  bool gpu_ = false;
   double build_ms_ = 0.0;
   std::atomic<uint64_t> launches_{0};
   std::mutex batch_mutex_;

@@ -95,17 +95,15 @@ class ClXpbdSolver {
   const std::string& lastError() const { return device_error_; }
   bool usesLocalMemory() const { return !usesPhases() && particleCount() <= runtime_->localParticles(); }
   // How a frame runs. Auto: one work-group launch (drape_xpbd_frame) for small garments (at most
-  // kWorkGroupMaxParticles and fitting in __local memory), else one launch per phase over global
-  // memory (drape_phase_*: every compute unit takes part). The two give bit-identical results
-  // (tested). The limit is measured (docs/opencl.md): on PoCL the phases already win at 7 800
-  // particles, and one work-group of 256 items cannot keep a GPU busy beyond a few thousand.
-  static constexpr size_t kWorkGroupMaxParticles = 4096;
+  // ClRuntime::workGroupMaxParticles: fitting in __local memory, 4 096 on a CPU device, 1 200 on
+  // a GPU), else one launch per phase over global memory (drape_phase_*: every compute unit takes
+  // part). The two give bit-identical results (tested). The limits are measured (docs/opencl.md):
+  // on PoCL the phases win from ~7 800 particles, on an H100 from ~1 120.
   enum class Path { Auto, WorkGroup, Phases };
   void setPath(Path p) { path_ = p; }
   bool usesPhases() const {
     return path_ == Path::Phases ||
-           (path_ == Path::Auto &&
-            particleCount() > std::min(kWorkGroupMaxParticles, runtime_->localParticles()));
+           (path_ == Path::Auto && particleCount() > runtime_->workGroupMaxParticles());
   }
   const ClRuntime& runtime() const { return *runtime_; }
 
