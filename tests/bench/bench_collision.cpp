@@ -5,6 +5,8 @@
 #include "proxies/closest_point.h"
 #include "proxies/collision.h"
 
+#include "../native/random_draws.h"
+
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -98,7 +100,7 @@ BodyScene makeScene(int particles, bool shell) {
       const int pick = static_cast<int>(std::uniform_int_distribution<int>(0, 25)(rng));
       const int k = pick < 22 ? pick : (pick == 22 ? 27 : pick == 23 ? 28 : pick == 24 ? 31 : 32);
       const Ellipsoid& e = s.end[static_cast<size_t>(k)];
-      Vec3 d(u(rng), u(rng), u(rng));
+      Vec3 d = test::draw3(u, rng);
       if (d.squaredNorm() < 1e-4f) continue;
       d.normalize();
       const Vec3 surface = e.centre + e.rotation * (e.radii + Vec3::Constant(margin)).cwiseProduct(d);
@@ -114,9 +116,12 @@ BodyScene makeScene(int particles, bool shell) {
       const Vec3 n = (e.rotation * d.cwiseQuotient(e.radii + Vec3::Constant(margin))).normalized();
       p = surface + n * (0.004f * u(rng));
     } else {
-      p = Vec3(0.45f * u(rng), 0.875f + 0.875f * u(rng), 0.2f * u(rng));
+      const float px = 0.45f * u(rng);
+      const float py = 0.875f + 0.875f * u(rng);
+      const float pz = 0.2f * u(rng);
+      p = Vec3(px, py, pz);
     }
-    const Vec3 v = Vec3(u(rng), u(rng), u(rng)) * 0.002f;
+    const Vec3 v = test::draw3(u, rng) * 0.002f;
     s.x.emplace_back(p.x(), p.y(), p.z(), 1.0f);
     s.prev.emplace_back(p.x() - v.x(), p.y() - v.y(), p.z() - v.z(), 1.0f);
   }
@@ -158,7 +163,7 @@ std::vector<Vec3> pointsAround(const Ellipsoid& e, int n, float lo, float hi) {
   std::uniform_real_distribution<float> u(-1.0f, 1.0f), r(lo, hi);
   std::vector<Vec3> pts;
   while (static_cast<int>(pts.size()) < n) {
-    Vec3 d(u(rng), u(rng), u(rng));
+    Vec3 d = test::draw3(u, rng);
     if (d.squaredNorm() < 1e-4f) continue;
     pts.push_back(e.fromUnit(d.normalized() * r(rng)));
   }

@@ -2,6 +2,7 @@
 #include "proxies/closest_point.h"
 #include "proxies/collision.h"
 
+#include "random_draws.h"
 #include "sanitizer_scale.h"
 
 #include <gtest/gtest.h>
@@ -109,7 +110,7 @@ std::vector<Vec3> probePoints(const Vec3& r, std::mt19937& rng, int random_count
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   std::uniform_real_distribution<float> scale(0.05f, 2.5f);
   for (int i = 0; i < random_count; ++i) {
-    Vec3 d(u(rng), u(rng), u(rng));
+    Vec3 d = test::draw3(u, rng);
     if (d.norm() < 1e-3f) continue;
     d.normalize();
     pts.push_back(r.cwiseProduct(d) * scale(rng));
@@ -134,7 +135,7 @@ std::vector<Vec3> probePoints(const Vec3& r, std::mt19937& rng, int random_count
   }
   // On the surface and 1 mm inside / outside it.
   for (int i = 0; i < 6; ++i) {
-    Vec3 d(u(rng), u(rng), u(rng));
+    Vec3 d = test::draw3(u, rng);
     d.normalize();
     const Vec3 s = r.cwiseProduct(d);
     const Vec3 n = s.cwiseQuotient(r.cwiseProduct(r)).normalized();
@@ -180,9 +181,9 @@ TEST(ClosestPoint, MatchesBruteForceRotated) {
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   for (const Vec3& r : kShapes) {
     for (int rep = 0; rep < test::repeatsUnderSanitizers(2, 2); ++rep) {
-      const Quat rot = Quat(Eigen::Vector4f(u(rng), u(rng), u(rng), u(rng)).normalized());
+      const Quat rot = Quat(test::draw4(u, rng).normalized());
       const Mat3 R = rot.toRotationMatrix();
-      const Vec3 c = Vec3(u(rng), u(rng), u(rng)) * 0.01f;
+      const Vec3 c = test::draw3(u, rng) * 0.01f;
       const std::vector<Vec3> probes = probePoints(r, rng, test::repeatsUnderSanitizers(4, 4));
       // Under the sanitizers the random probe and every other fixed one (odd indices: the centre,
       // then points on each axis, in each coordinate plane, on and either side of the surface, all
@@ -214,9 +215,11 @@ TEST(ClosestPoint, FastAgreesWithBisection) {
   std::uniform_real_distribution<float> u(-1.0f, 1.0f), lr(-2.5f, 1.0f);
   double worst = 0.0;
   for (int i = 0; i < 200000; ++i) {
-    const Vec3 r(std::pow(10.0f, lr(rng)) * 0.1f, std::pow(10.0f, lr(rng)) * 0.1f,
-                 std::pow(10.0f, lr(rng)) * 0.1f);
-    const Vec3 p = r.cwiseProduct(Vec3(u(rng), u(rng), u(rng))) * 1.5f;
+    const float rx = std::pow(10.0f, lr(rng)) * 0.1f;
+    const float ry = std::pow(10.0f, lr(rng)) * 0.1f;
+    const float rz = std::pow(10.0f, lr(rng)) * 0.1f;
+    const Vec3 r(rx, ry, rz);
+    const Vec3 p = r.cwiseProduct(test::draw3(u, rng)) * 1.5f;
     float d0 = 0.0f, d1 = 0.0f;
     const Vec3 a = closestPointOnEllipsoid(r, p, &d0);
     const Vec3 b = closestPointOnEllipsoidFast(r, p, &d1);
@@ -325,7 +328,7 @@ TEST(Collider, RadialVersusExact) {
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   std::vector<Vec4> pts;
   while (pts.size() < 20000) {
-    const Vec3 q(u(rng), u(rng), u(rng));
+    const Vec3 q = test::draw3(u, rng);
     if (q.squaredNorm() >= 0.999f) continue;
     pts.emplace_back(Vec4(0, 0, 0, 1));
     pts.back().head<3>() = e.fromUnit(q);
@@ -409,7 +412,7 @@ TEST(Collider, PressedParticlesNeverEndInsideMovingEllipsoid) {
       // other places on the ellipsoid; the contact bound below is per particle.
       const int count = test::repeatsUnderSanitizers(300, 3);
       for (int i = 0; i < count; ++i) {
-        const Vec3 d = Vec3(u(rng), u(rng), u(rng)).normalized();
+        const Vec3 d = test::draw3(u, rng).normalized();
         ps.add(e0.fromUnit(d * 1.3f));
       }
       EllipsoidCollider col;
@@ -442,16 +445,21 @@ TEST(Collider, OverlapsResolvedWithinTolerance) {
   for (int scene = 0; scene < 20; ++scene) {
     std::vector<Ellipsoid> es;
     for (int k = 0; k < 12; ++k) {
-      const Quat q(Eigen::Vector4f(u(rng), u(rng), u(rng), u(rng)).normalized());
-      es.push_back(makeEllipsoid(Vec3(u(rng), u(rng), u(rng)) * 0.08f,
-                                 Vec3(0.02f + 0.08f * r01(rng), 0.02f + 0.08f * r01(rng), 0.01f + 0.05f * r01(rng)),
-                                 q.toRotationMatrix()));
+      const Quat q(test::draw4(u, rng).normalized());
+      const Vec3 centre = test::draw3(u, rng) * 0.08f;
+      const float rx = 0.02f + 0.08f * r01(rng);
+      const float ry = 0.02f + 0.08f * r01(rng);
+      const float rz = 0.01f + 0.05f * r01(rng);
+      es.push_back(makeEllipsoid(centre, Vec3(rx, ry, rz), q.toRotationMatrix()));
     }
     EllipsoidCollider col;
     col.setEllipsoids(es.data(), es.data(), static_cast<int>(es.size()));
     for (int response = 0; response < 2; ++response) {
       std::vector<Vec4> x;
-      for (int i = 0; i < 2000; ++i) x.emplace_back(u(rng) * 0.15f, u(rng) * 0.15f, u(rng) * 0.15f, 1.0f);
+      for (int i = 0; i < 2000; ++i) {
+        const Vec3 at = test::draw3(u, rng) * 0.15f;
+        x.emplace_back(at.x(), at.y(), at.z(), 1.0f);
+      }
       std::vector<Vec4> prev = x;
       CollisionParams p;
       p.response = static_cast<ContactResponse>(response);
@@ -688,17 +696,28 @@ Scene randomScene(int ellipsoids, int particles, unsigned seed) {
   std::uniform_real_distribution<float> u(-1.0f, 1.0f), r01(0.0f, 1.0f);
   Scene s;
   for (int k = 0; k < ellipsoids; ++k) {
-    const Quat q(Eigen::Vector4f(u(rng), u(rng), u(rng), u(rng)).normalized());
-    const Vec3 c(0.6f * u(rng), 0.9f + 0.8f * u(rng), 0.15f * u(rng));
-    const Vec3 radii(0.02f + 0.1f * r01(rng), 0.02f + 0.2f * r01(rng), 0.02f + 0.1f * r01(rng));
+    const Quat q(test::draw4(u, rng).normalized());
+    const float cx = 0.6f * u(rng);
+    const float cy = 0.9f + 0.8f * u(rng);
+    const float cz = 0.15f * u(rng);
+    const Vec3 c(cx, cy, cz);
+    const float rx = 0.02f + 0.1f * r01(rng);
+    const float ry = 0.02f + 0.2f * r01(rng);
+    const float rz = 0.02f + 0.1f * r01(rng);
+    const Vec3 radii(rx, ry, rz);
     s.start.push_back(makeEllipsoid(c, radii, q.toRotationMatrix()));
-    const Quat dq(Eigen::AngleAxisf(0.2f * u(rng), Vec3(u(rng), u(rng), u(rng)).normalized()));
-    s.end.push_back(makeEllipsoid(c + Vec3(u(rng), u(rng), u(rng)) * 0.03f, radii, (dq * q).toRotationMatrix()));
+    const float turn = 0.2f * u(rng);
+    const Vec3 axis = test::draw3(u, rng).normalized();
+    const Quat dq(Eigen::AngleAxisf(turn, axis));
+    s.end.push_back(makeEllipsoid(c + test::draw3(u, rng) * 0.03f, radii, (dq * q).toRotationMatrix()));
   }
   for (int i = 0; i < particles; ++i) {
-    const Vec3 p(0.8f * u(rng), 0.9f + 1.0f * u(rng), 0.25f * u(rng));
+    const float px = 0.8f * u(rng);
+    const float py = 0.9f + 1.0f * u(rng);
+    const float pz = 0.25f * u(rng);
+    const Vec3 p(px, py, pz);
     const float speed = r01(rng) < 0.1f ? 0.2f : 0.01f;  // a few fast ones for the swept test
-    const Vec3 p0 = p + Vec3(u(rng), u(rng), u(rng)) * speed;
+    const Vec3 p0 = p + test::draw3(u, rng) * speed;
     s.x.emplace_back(p.x(), p.y(), p.z(), r01(rng) < 0.05f ? 0.0f : 1.0f);
     s.prev.emplace_back(p0.x(), p0.y(), p0.z(), 1.0f);
   }

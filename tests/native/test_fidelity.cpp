@@ -3,6 +3,7 @@
 #include "body/body_model.h"
 #include "body/mesh_metrics.h"
 #include "proxies/fidelity.h"
+#include "random_draws.h"
 #include "sanitizer_scale.h"
 
 #include <gtest/gtest.h>
@@ -222,14 +223,17 @@ TEST(Fidelity, EllipsoidDistanceMatchesBruteForce) {
   const int cases = test::repeatsUnderSanitizers(300, 3);
   for (int i = 0; i < cases; ++i) {
     Ellipsoid e;
-    e.centre = kCentre + 0.2f * Vec3(unit(rng), unit(rng), unit(rng));
-    e.rotation = Eigen::AngleAxisf(angle(rng), Vec3(unit(rng), unit(rng), unit(rng)).normalized())
-                     .toRotationMatrix();
-    e.radii = Vec3(radius(rng), radius(rng), radius(rng));
+    e.centre = kCentre + 0.2f * test::draw3(unit, rng);
+    const float turn = angle(rng);
+    const Vec3 axis = test::draw3(unit, rng).normalized();
+    e.rotation = Eigen::AngleAxisf(turn, axis).toRotationMatrix();
+    e.radii = test::draw3(radius, rng);
     if (i % 10 == 0) e.radii.y() = e.radii.x();  // equal radii: the degenerate branches
     e.refresh();
     // Points from deep inside to 0.5 m outside; some exactly on a symmetry plane.
-    Vec3 local = Vec3(unit(rng), unit(rng), unit(rng)).cwiseProduct(e.radii) * (0.3f + 2.5f * std::fabs(unit(rng)));
+    const Vec3 dir = test::draw3(unit, rng);
+    const float reach = 0.3f + 2.5f * std::fabs(unit(rng));
+    Vec3 local = dir.cwiseProduct(e.radii) * reach;
     if (i % 7 == 0) local.z() = 0.0f;
     if (i % 11 == 0) local.x() = 0.0f;
     const Vec3 p = e.centre + e.rotation * local;

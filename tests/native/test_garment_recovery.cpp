@@ -4,6 +4,7 @@
 // before; a burst of 5 cm sensor noise ends with the garment restored to its state before the
 // burst, swept to the current pose. Driven through drape::Context with the tracker in the loop.
 #include "garment_scene.h"
+#include "random_draws.h"
 #include "test_data.h"
 
 #include "cloth/garment_sim.h"
@@ -143,7 +144,7 @@ TEST(GarmentRecovery, FlipThatComesBackTooLateIsReplaced) {
 SkeletonPose jittered(const SkeletonPose& p, float sigma, std::mt19937& rng) {
   std::normal_distribution<float> n(0.0f, sigma);
   SkeletonPose out = p;
-  for (Vec3& j : out.position) j += Vec3(n(rng), n(rng), n(rng));
+  for (Vec3& j : out.position) j += test::draw3(n, rng);
   return out;
 }
 

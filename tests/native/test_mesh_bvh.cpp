@@ -6,6 +6,7 @@
 #include "proxies/mesh_bvh.h"
 #include "proxies/mesh_collider.h"
 
+#include "random_draws.h"
 #include "sanitizer_scale.h"
 
 #include <gtest/gtest.h>
@@ -61,8 +62,10 @@ std::vector<Vec3> probePoints(const std::vector<Vec3>& P, const std::vector<uint
   std::vector<Vec3> out;
   for (int i = 0; i < count; ++i) {
     if (i % 2 == 0) {
-      out.emplace_back(lo.x() + unit(rng) * (hi.x() - lo.x()), lo.y() + unit(rng) * (hi.y() - lo.y()),
-                       lo.z() + unit(rng) * (hi.z() - lo.z()));
+      const float x = lo.x() + unit(rng) * (hi.x() - lo.x());
+      const float y = lo.y() + unit(rng) * (hi.y() - lo.y());
+      const float z = lo.z() + unit(rng) * (hi.z() - lo.z());
+      out.emplace_back(x, y, z);
     } else {
       const size_t t = tri(rng);
       const Vec3 a = P[I[3 * t]], b = P[I[3 * t + 1]], c = P[I[3 * t + 2]];
@@ -101,11 +104,11 @@ TEST(TriangleBvh, ClosestPointOnTriangleMatchesReference) {
   const Vec3 base(0.3f, 1.1f, 2.5f);  // where the body stands
   int feature_seen[7] = {};
   for (int i = 0; i < 20000; ++i) {
-    const Vec3 a = base + Vec3(coord(rng), coord(rng), coord(rng));
-    const Vec3 b = base + Vec3(coord(rng), coord(rng), coord(rng));
-    const Vec3 c = base + Vec3(coord(rng), coord(rng), coord(rng));
+    const Vec3 a = base + test::draw3(coord, rng);
+    const Vec3 b = base + test::draw3(coord, rng);
+    const Vec3 c = base + test::draw3(coord, rng);
     if ((b - a).cross(c - a).norm() < 1e-4f) continue;
-    const Vec3 p = base + 2.0f * Vec3(coord(rng), coord(rng), coord(rng));
+    const Vec3 p = base + 2.0f * test::draw3(coord, rng);
     TriangleFeature f;
     const Vec3 q = closestPointOnTriangle(p, a, b, c, &f);
     ++feature_seen[static_cast<int>(f)];

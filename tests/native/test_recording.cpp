@@ -585,7 +585,10 @@ Recording randomRecording(Layout layout, int frames, unsigned seed) {
     t += 1.0 / 29.97 + 1e-9 * i;
     f.joints.resize(static_cast<std::size_t>(layoutJointCount(layout)));
     for (auto& j : f.joints) {
-      j.position = Vec3(pos(rng), pos(rng) * 1e-3f, pos(rng) * 1e5f);
+      const float x = pos(rng);
+      const float y = pos(rng) * 1e-3f;
+      const float z = pos(rng) * 1e5f;
+      j.position = Vec3(x, y, z);
       j.state = static_cast<TrackingState>(st(rng));
     }
     r.frames.push_back(std::move(f));
@@ -881,7 +884,12 @@ TEST(RecordingErrors, MutationFuzzNeverCrashes) {
         case 1: s.erase(at, 1 + rng() % 16); break;
         case 2: s.insert(at, 1, "{}\n ,-.e9"[rng() % 9]); break;
         case 3: s.resize(at); break;
-        default: s.insert(at, s.substr(rng() % s.size(), rng() % 64)); break;
+        default: {
+          const std::size_t from = rng() % s.size();
+          const std::size_t len = rng() % 64;
+          s.insert(at, s.substr(from, len));
+          break;
+        }
       }
     }
     Recording rec;

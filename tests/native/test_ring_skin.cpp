@@ -4,6 +4,7 @@
 // points on and around the body, with and without blending, placed on the rings bound to and on
 // moved, rescaled rings.
 #include "garment_scene.h"
+#include "random_draws.h"
 #include "sanitizer_scale.h"
 
 #include "cloth/garment_templates.h"
@@ -89,7 +90,7 @@ TEST(RingSkin, SkippingFarSegmentsBindsAsEverySegment) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   for (int i = 0; i < test::repeatsUnderSanitizers(1500, 4); ++i) {
-    const Vec3 f(u(rng), u(rng), u(rng));
+    const Vec3 f = test::draw3(u, rng);
     points.push_back(lo - Vec3::Constant(0.25f) + f.cwiseProduct(hi - lo + Vec3::Constant(0.5f)));
   }
   // Moved and rescaled rings: a turned, shifted body with thicker limbs.

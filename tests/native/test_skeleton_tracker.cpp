@@ -3,6 +3,7 @@
 #include "recording/recording.h"
 #include "skeleton/tracker.h"
 
+#include "random_draws.h"
 #include "skeleton/layouts.h"
 #include "test_data.h"
 
@@ -184,7 +185,7 @@ TEST(SkeletonTrackerRecording, NoiseEstimateFindsJitterAndIgnoresJumps) {
     for (size_t i = 0; i < r.raw.size(); ++i) {
       clean.push(r.raw[i], r.t[i]);
       SkeletonPose noisy = r.raw[i], flip = r.raw[i];
-      for (Vec3& p : noisy.position) p += Vec3(n(rng), n(rng), n(rng));
+      for (Vec3& p : noisy.position) p += test::draw3(n, rng);
       jittered.push(noisy, r.t[i]);
       if (i == r.raw.size() / 2)  // every joint reflected through the pelvis for one frame
         for (Vec3& p : flip.position) p = 2.0f * r.raw[i].position[0] - p;
