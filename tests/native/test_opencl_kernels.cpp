@@ -435,7 +435,7 @@ TEST(OpenClKernels, PhaseLaunchesMatchTheWorkGroupFrameBitForBit) {
 
 // The automatic path: one work-group up to the device's limit (what fits in __local memory, 4 096
 // particles on a CPU device such as PoCL, 1 200 on a GPU, where the per-phase launches win from
-// ~1 120 particles with collision: docs/opencl.md, "Fifth lease"), the per-phase launches above.
+// ~1 100-1 300 particles with collision: docs/opencl.md, "Fifth lease"), the per-phase launches above.
 TEST(OpenClKernels, AutomaticPathSwitchesAtTheDeviceLimit) {
   DRAPE_REQUIRE_OPENCL(rt);
   const size_t limit = rt->workGroupMaxParticles();

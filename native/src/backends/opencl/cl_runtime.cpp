@@ -35,6 +35,10 @@ T deviceValue(cl_device_id d, cl_device_info what) {
   return v;
 }
 
+bool isGpuDevice(cl_device_id d) {
+  return (deviceValue<cl_device_type>(d, CL_DEVICE_TYPE) & CL_DEVICE_TYPE_GPU) != 0;
+}
+
 std::vector<cl_platform_id> platforms(std::string& err) {
   cl_uint n = 0;
   const cl_int rc = clGetPlatformIDs(0, nullptr, &n);
@@ -102,7 +106,7 @@ std::vector<ClDeviceDesc> listClDevices(std::string& err) {
       desc.device = static_cast<int>(d);
       desc.platform_name = platformString(ps[p], CL_PLATFORM_NAME);
       desc.device_name = deviceString(ds[d], CL_DEVICE_NAME);
-      desc.gpu = (deviceValue<cl_device_type>(ds[d], CL_DEVICE_TYPE) & CL_DEVICE_TYPE_GPU) != 0;
+      desc.gpu = isGpuDevice(ds[d]);
       desc.global_mem = deviceValue<cl_ulong>(ds[d], CL_DEVICE_GLOBAL_MEM_SIZE);
       desc.local_mem = deviceValue<cl_ulong>(ds[d], CL_DEVICE_LOCAL_MEM_SIZE);
       desc.compute_units = deviceValue<cl_uint>(ds[d], CL_DEVICE_MAX_COMPUTE_UNITS);
@@ -193,7 +197,7 @@ bool ClRuntime::build(const ClChoice& choice, std::string& err) {
           continue;
         }
         for (cl_device_id d : ds) {
-          const bool gpu = (deviceValue<cl_device_type>(d, CL_DEVICE_TYPE) & CL_DEVICE_TYPE_GPU) != 0;
+          const bool gpu = isGpuDevice(d);
           if (pass == 0 && choice.prefer_gpu && !gpu) continue;
           device_ = d;
           platform = ps[p];
@@ -233,7 +237,7 @@ bool ClRuntime::build(const ClChoice& choice, std::string& err) {
   work_group_ = std::max<size_t>(1, std::min<size_t>(256, max_wg));
   const cl_ulong local = deviceValue<cl_ulong>(device_, CL_DEVICE_LOCAL_MEM_SIZE);
   local_particles_ = local > 4096 ? std::min<size_t>(65536, static_cast<size_t>((local - 4096) / 16)) : 1;
-  gpu_ = (deviceValue<cl_device_type>(device_, CL_DEVICE_TYPE) & CL_DEVICE_TYPE_GPU) != 0;
+  gpu_ = isGpuDevice(device_);
   work_group_max_particles_ =
       std::min(local_particles_, gpu_ ? kGpuWorkGroupMaxParticles : kWorkGroupMaxParticles);
 

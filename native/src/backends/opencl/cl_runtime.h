@@ -69,7 +69,7 @@ class ClRuntime {
   // launch cost that hardly depends on the size. On an H100 (docs/opencl.md, "Fifth lease",
   // BM_BackendGarmentFrame with collision, medians of 5) the work-group frame took 1.45 ms at 885
   // particles against 1.73 for the phases, and 2.23 against 1.61 at 1 810; the lines cross near
-  // 1 120. On PoCL (the CPU as the device) the phases only win from ~7 800 particles: 4 096 there.
+  // 1 100-1 300 (two runs). On PoCL (the CPU as the device) the phases only win from ~7 800 particles: 4 096 there.
   static constexpr size_t kWorkGroupMaxParticles = 4096;
   static constexpr size_t kGpuWorkGroupMaxParticles = 1200;
   size_t workGroupMaxParticles() const { return work_group_max_particles_; }

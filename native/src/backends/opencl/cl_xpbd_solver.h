@@ -98,7 +98,7 @@ class ClXpbdSolver {
   // ClRuntime::workGroupMaxParticles: fitting in __local memory, 4 096 on a CPU device, 1 200 on
   // a GPU), else one launch per phase over global memory (drape_phase_*: every compute unit takes
   // part). The two give bit-identical results (tested). The limits are measured (docs/opencl.md):
-  // on PoCL the phases win from ~7 800 particles, on an H100 from ~1 120.
+  // on PoCL the phases win from ~7 800 particles, on an H100 from ~1 100-1 300.
   enum class Path { Auto, WorkGroup, Phases };
   void setPath(Path p) { path_ = p; }
   bool usesPhases() const {
