@@ -32,7 +32,7 @@ Ellipsoid make(const Vec3& c, const Vec3& radii, const Mat3& R = Mat3::Identity(
 // A limb ellipsoid along the bone a -> b (y axis along the bone, semi-axis = half the length).
 Ellipsoid limb(const Vec3& a, const Vec3& b, float radius) {
   const Vec3 y = (b - a).normalized();
-  const Mat3 R = Quat::FromTwoVectors(Vec3::UnitY(), y).toRotationMatrix();
+  const Mat3 R = drape::rotationBetween(Vec3::UnitY(), y).toRotationMatrix();
   return make(0.5f * (a + b), Vec3(radius, 0.5f * (b - a).norm(), radius), R);
 }
 

@@ -264,7 +264,7 @@ void BodyModel::placeRings(const SkeletonPose& pose) {
       const RingStation& st = stations_[r];
       Vec3 centre, dir;
       along(c, st.u, st.offset_m, centre, dir, y);
-      const Quat q = Quat::FromTwoVectors(y, dir);
+      const Quat q = rotationBetween(y, dir);
       x = q * x;
       y = dir;
       x = safeNormalized(x - x.dot(y) * y, anyPerpendicular(y));

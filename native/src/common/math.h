@@ -26,4 +26,8 @@ inline Vec3 anyPerpendicular(const Vec3& n) {
   return n.cross(a).normalized();
 }
 
+// The shortest rotation taking the direction of `from` to that of `to` (neither need be unit
+// length; both non-zero): Eigen's Quaternion::FromTwoVectors, compiled once in math.cpp.
+Quat rotationBetween(const Vec3& from, const Vec3& to);
+
 }  // namespace drape

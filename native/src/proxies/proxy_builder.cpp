@@ -124,7 +124,7 @@ void ProxyBuilder::buildAll(const BodyModel& body, const SkeletonPose& pose) {
         const Vec3 dir = b - a;
         if (dir.norm() > 1e-6f) {
           // Align the frame's y with this bone exactly (the ring may sit at the bone's end).
-          const Quat q = Quat::FromTwoVectors(e.rotation.col(1), dir.normalized());
+          const Quat q = rotationBetween(e.rotation.col(1), dir.normalized());
           e.rotation = (q.toRotationMatrix() * e.rotation).eval();
         }
         e.radii = Vec3(std::max(radius, 1e-3f), std::max(0.5f * dir.norm(), 1e-3f), std::max(radius, 1e-3f));
@@ -217,7 +217,7 @@ void ProxyBuilder::buildAll(const BodyModel& body, const SkeletonPose& pose) {
       e.centre = r.centre + 0.5f * span;
       e.rotation = r.frame;
       if (len > 1e-6f) {
-        const Quat q = Quat::FromTwoVectors(r.frame.col(1), span / len);
+        const Quat q = rotationBetween(r.frame.col(1), span / len);
         e.rotation = (q.toRotationMatrix() * r.frame).eval();
       }
       e.radii = Vec3(std::max(0.45f * r.forward_m, 1e-3f), std::max(0.52f * len, 1e-3f),

@@ -56,7 +56,7 @@ float alphaFor(float cutoff_hz, float dt) {
 // Rotates `a` toward `b` (unit vectors) by fraction w of the angle between them.
 Vec3 slerpDir(const Vec3& a, const Vec3& b, float w) {
   if (w >= 1.0f) return b;
-  const Quat q = Quat::FromTwoVectors(a, b);
+  const Quat q = rotationBetween(a, b);
   const Vec3 r = Quat::Identity().slerp(w, q) * a;
   const float n = r.norm();
   return (n > 1e-6f && std::isfinite(n)) ? Vec3(r / n) : b;
@@ -431,7 +431,7 @@ void SkeletonTracker::push(const SkeletonPose& raw, double time_s) {
       if (has_pose_ && t < blend_end_[j]) {
         // Recovering: move the remaining angle between the held and the live direction linearly
         // in time, reaching the live direction at blend_end_.
-        const Vec3 held = pb >= 0 ? Vec3(Quat::FromTwoVectors(prevDir[pb], dir_[pb]) * prevDir[b])
+        const Vec3 held = pb >= 0 ? Vec3(rotationBetween(prevDir[pb], dir_[pb]) * prevDir[b])
                                   : prevDir[b];
         const float a = static_cast<float>(dtd / (blend_end_[j] - t + dtd));
         d = slerpDir(held, liveDir, a);
@@ -446,7 +446,7 @@ void SkeletonTracker::push(const SkeletonPose& raw, double time_s) {
       }
       if (has_pose_) {
         // Hold the angle to the parent bone: turn the previous direction with the parent's swing.
-        d = pb >= 0 ? Vec3(Quat::FromTwoVectors(prevDir[pb], dir_[pb]) * prevDir[b]) : prevDir[b];
+        d = pb >= 0 ? Vec3(rotationBetween(prevDir[pb], dir_[pb]) * prevDir[b]) : prevDir[b];
         const float n = d.norm();
         d = (n > 1e-6f && std::isfinite(n)) ? Vec3(d / n) : fallback;
       } else {
