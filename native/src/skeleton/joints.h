@@ -49,6 +49,10 @@ constexpr int boneParent(int bone) { return kJointParent[bone + 1]; }
 const char* jointName(Joint j);
 
 enum class TrackingState : uint8_t { NotTracked = 0, Inferred = 1, Tracked = 2 };
+// A state read from the host outside 0..2 counts as NotTracked.
+inline TrackingState sanitizeState(TrackingState s) {
+  return static_cast<unsigned>(s) <= 2u ? s : TrackingState::NotTracked;
+}
 
 // Sensor layouts (values equal the C ABI's drape_layout).
 enum class Layout : int { Kinect1 = 1, Kinect2 = 2, Azure = 3 };

@@ -60,10 +60,6 @@ const char* layoutName(Layout layout) {
   return "?";
 }
 
-TrackingState sanitizeState(TrackingState s) {
-  const auto v = static_cast<unsigned>(s);
-  return v <= 2u ? s : TrackingState::NotTracked;
-}
 TrackingState minState(TrackingState a, TrackingState b) {
   return static_cast<unsigned>(a) < static_cast<unsigned>(b) ? a : b;
 }

@@ -43,10 +43,6 @@ TrackerParams sanitize(const TrackerParams& in) {
   return p;
 }
 
-TrackingState sanitizeState(TrackingState s) {
-  return static_cast<unsigned>(s) <= 2u ? s : TrackingState::NotTracked;
-}
-
 // One-Euro smoothing factor for a first-order low-pass at `cutoff_hz` sampled every dt.
 float alphaFor(float cutoff_hz, float dt) {
   const float r = 2.0f * kPi * cutoff_hz * dt;

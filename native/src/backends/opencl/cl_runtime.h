@@ -19,6 +19,12 @@ namespace drape {
 
 class ClFrameBatch;
 
+// Releases a buffer the caller owns (if any) and clears the handle, so a second call is harmless.
+inline void release(cl_mem& m) {
+  if (m) clReleaseMemObject(m);
+  m = nullptr;
+}
+
 struct ClDeviceDesc {
   int platform = 0, device = 0;  // indices as enumerated
   std::string platform_name, device_name;

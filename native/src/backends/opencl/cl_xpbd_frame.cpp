@@ -30,11 +30,6 @@ double sumAndRelease(std::vector<cl_event>& events, bool profiling) {
   return ns;
 }
 
-void release(cl_mem& m) {
-  if (m) clReleaseMemObject(m);
-  m = nullptr;
-}
-
 }  // namespace
 
 bool ClXpbdSolver::enqueuePhases(std::vector<cl_event>& runs) {
