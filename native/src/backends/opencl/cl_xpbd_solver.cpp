@@ -10,7 +10,6 @@
 namespace drape {
 namespace {
 
-
 // Appends the colour groups of `c` to the device lists; w_sum = w_a + w_b (one-sided tethers:
 // w_a), the part of 1 / (w_a + w_b + alpha~) that does not change with h (DrapeClConstraint).
 void appendGroups(const DistanceConstraints& c, bool one_sided, const std::vector<float>& w,
