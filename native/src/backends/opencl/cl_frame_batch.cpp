@@ -14,13 +14,13 @@ ClFrameBatch::~ClFrameBatch() {
   for (Buffer* b : {&garments_, &x_, &prev_, &v_, &span_start_, &pin_start_, &pin_index_, &pin_target_, &constraints_,
                     &groups_, &masks_, &shapes_, &bounds_, &stats_, &transforms_, &work_, &triangles_, &face_offsets_,
                     &vertex_faces_})
-    if (b->mem) clReleaseMemObject(b->mem);
+    release(b->mem);
 }
 
 bool ClFrameBatch::grow(cl_mem& buffer, size_t& capacity, size_t bytes, cl_mem_flags flags) {
   bytes = std::max<size_t>(bytes, 16);
   if (buffer && bytes <= capacity) return true;
-  if (buffer) clReleaseMemObject(buffer);
+  release(buffer);
   // Half as much again: a growing crowd of garments reallocates a few times, not every frame.
   capacity = bytes + bytes / 2;
   cl_int rc = CL_SUCCESS;
