@@ -60,7 +60,7 @@ inline GarmentSim* addTemplate(Context& ctx, GarmentKind kind, int particles, Cl
   tp.kind = kind;
   tp.target_particles = particles;
   auto g = GarmentSim::createTemplate(tp, TopologyParams{}, solver, params, dress_time_s, ctx.restBody(),
-                                     ctx.restEllipsoids(), ctx.restEllipsoidChains(), err);
+                                     ctx.restEllipsoids(), ctx.restEllipsoidGroups(), err);
   return g ? ctx.adoptGarment(std::move(g)) : nullptr;
 }
 

@@ -26,11 +26,19 @@ PipelineOptions fullPipeline() {
   return o;
 }
 
-// The chains of the ellipsoids the garment collides with now.
+// The chains through which the garment collides with the ellipsoids it reaches now: each
+// reachable ellipsoid's collision groups that some particle of the garment collides with (a
+// shoulder fill is the arm's and the torso's: a skirt's waistband reaches it as torso).
 std::set<Chain> reachedChains(Context& ctx, const GarmentSim& g) {
+  uint8_t masks = 0;
+  for (uint8_t m : g.particleMasks()) masks = static_cast<uint8_t>(masks | m);
   std::set<Chain> out;
   const auto& sources = ctx.proxies().sources();
-  for (int k : g.reachable()) out.insert(sources[static_cast<size_t>(k)].chain);
+  for (int k : g.reachable()) {
+    const uint8_t groups = static_cast<uint8_t>(collisionGroups(sources[static_cast<size_t>(k)]) & masks);
+    for (int c = 0; c < kChainCount; ++c)
+      if (groups & (1u << c)) out.insert(static_cast<Chain>(c));
+  }
   return out;
 }
 
@@ -166,7 +174,7 @@ TEST(ProxyCulling, ReachSpheresFollowTheCut) {
   GarmentMesh mesh;
   ASSERT_TRUE(makeGarmentTemplate(ctx.restBody(), tp, mesh, err)) << err;
   auto longer = GarmentSim::create(mesh, TopologyParams{}, ClothSolverKind::Xpbd, GarmentSimParams{}, 0.2f,
-                                   ctx.restBody(), ctx.restEllipsoids(), ctx.restEllipsoidChains(), err);
+                                   ctx.restBody(), ctx.restEllipsoids(), ctx.restEllipsoidGroups(), err);
   ASSERT_NE(longer, nullptr) << err;
   auto maxRadius = [](const std::vector<ReachSphere>& s) {
     float r = 0.0f;

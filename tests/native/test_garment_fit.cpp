@@ -242,10 +242,10 @@ TEST(GarmentFit, CalibrationRecutsTheGarmentsForThePersonsBones) {
     for (float r : fitted.garment->topology().stretch.rest) after += r;
     EXPECT_GT(std::fabs(after / before - 1.0), 0.005) << "a new cut";
     // The rest body's ellipsoids come in the frames' count and order (collision groups by index).
-    const std::vector<int>& chains = fitted.ctx->restEllipsoidChains();
+    const std::vector<uint8_t>& groups = fitted.ctx->restEllipsoidGroups();
     const std::vector<ProxySource>& sources = fitted.ctx->proxies().sources();
-    ASSERT_EQ(chains.size(), sources.size());
-    for (size_t k = 0; k < chains.size(); ++k) ASSERT_EQ(chains[k], static_cast<int>(sources[k].chain)) << k;
+    ASSERT_EQ(groups.size(), sources.size());
+    for (size_t k = 0; k < groups.size(); ++k) ASSERT_EQ(groups[k], collisionGroups(sources[k])) << k;
 
     uint64_t insideFitted = 0, insideStandard = 0;
     const float a = fitted.medianP99(40, &insideFitted);

@@ -128,14 +128,16 @@ TEST_P(Backends, ClothOnAStillBodyComesToRest) {
   Scene s;
   makeScene(s);
   std::vector<Eigen::Vector4f> before;
-  for (int f = 0; f < 45; ++f) {
-    if (f == 44) before.assign(s.garment->positions(), s.garment->positions() + s.garment->particleCount());
+  // 2 s: since the shoulder fills (docs/proxies.md) a few particles of the 600-particle T-shirt's
+  // first rows (the hem) still move ~2 mm a frame at 1.5 s, 1 mm at 2 s, 0.3-0.6 mm at 3.5 s.
+  for (int f = 0; f < 60; ++f) {
+    if (f == 59) before.assign(s.garment->positions(), s.garment->positions() + s.garment->particleCount());
     stepPose(*s.ctx, s.rest, f / 30.0, 1.0f / 30.0f);
   }
   float moved_m = 0.0f;
   for (size_t i = 0; i < before.size(); ++i)
     moved_m = std::max(moved_m, (s.garment->positions()[i] - before[i]).head<3>().norm());
-  EXPECT_LT(moved_m, 2e-3f) << "still moving after 1.5 s on a still body";
+  EXPECT_LT(moved_m, 2e-3f) << "still moving after 2 s on a still body";
   EXPECT_GT(s.garment->lastStep().substeps, 0);  // it was stepped, not asleep
   // (Velocities are not a measure of rest here: they include the last substep's collision
   // corrections, and particles resting against the body show ~4 m/s of it on both backends.)

@@ -296,7 +296,12 @@ TEST(StressBodyShape, BmiFifteenToFortyFiveHeightOneToTwoPointTwo) {
     std::snprintf(name, sizeof name, "height %.1f m, BMI %.0f", h, bmi);
     print(name, s);
     expectHealthy(s, name);
-    EXPECT_LE(s.maxP99(0, 1e9), 1.3f) << name;  // measured worst 0.96 (2.2 m, BMI 25)
+    // Measured worst 1.45 (2.2 m, BMI 15) since the shoulder fills (0.41 before, 0.96 at 2.2 m,
+    // BMI 25 earlier): that body's T-shirt has an opening off its body part most of the take and
+    // swings from run to run (the same body in drape-replay, 2 000 particles: pooled P99 32.3 %
+    // before the fills, 26.4 % with them; an opening off in 140 and 161 of 161 frames).
+    // docs/robustness.md, "Stress scenarios".
+    EXPECT_LE(s.maxP99(0, 1e9), 1.6f) << name;
   }
 }
 

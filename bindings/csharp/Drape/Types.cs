@@ -416,7 +416,9 @@ namespace Drape
     }
 
     /// <summary>drape_ellipsoid (68 bytes): one tracking ellipsoid. A world point p is inside when
-    /// |diag(1/Radii) * [AxisX AxisY AxisZ]^T (p - Centre)| &lt; 1.</summary>
+    /// |diag(1/Radii) * [AxisX AxisY AxisZ]^T (p - Centre)| &lt; 1. With the Drape rule the last two
+    /// are the shoulder fills (right, then left): Chain = the arm, Ring = its junction ring, AxisY
+    /// from the base of the neck to the shoulder joint; torso cloth collides with them too.</summary>
     [StructLayout(LayoutKind.Sequential)]
     public struct Ellipsoid
     {

@@ -237,7 +237,7 @@ drape_result adopt(const char* fn, Context& ctx, const drape::GarmentMesh& mesh,
                    const drape::GarmentSimParams& sim, drape_garment** out, bool cut_from_dressed) {
   std::string err;
   auto g = GarmentSim::create(mesh, topologyFrom(d), static_cast<drape::ClothSolverKind>(d.solver), sim,
-                              d.dress_time_s, ctx.restBody(), ctx.restEllipsoids(), ctx.restEllipsoidChains(), err,
+                              d.dress_time_s, ctx.restBody(), ctx.restEllipsoids(), ctx.restEllipsoidGroups(), err,
                               cut_from_dressed);
   return adoptCreated(fn, ctx, std::move(g), err, out);
 }
@@ -346,7 +346,7 @@ DRAPE_API drape_result DRAPE_CALL drape_context_add_garment_template(drape_conte
     std::string err;
     auto g = GarmentSim::createTemplate(tp, topologyFrom(d), static_cast<drape::ClothSolverKind>(d.solver), sim,
                                         d.dress_time_s, ctx->restBody(), ctx->restEllipsoids(),
-                                        ctx->restEllipsoidChains(), err);
+                                        ctx->restEllipsoidGroups(), err);
     return adoptCreated(fn, *ctx, std::move(g), err, out_garment);
   });
 }

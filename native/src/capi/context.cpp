@@ -177,7 +177,7 @@ bool Context::refitGarments(std::string& err, bool remake_templates) {
   refits.reserve(garments_.size());
   for (size_t i = 0; i < garments_.size(); ++i) {
     std::string why;
-    refits.push_back(garments_[i]->refitted(restBody(), restEllipsoids(), restEllipsoidChains(), why, remake_templates));
+    refits.push_back(garments_[i]->refitted(restBody(), restEllipsoids(), restEllipsoidGroups(), why, remake_templates));
     if (!refits.back()) {
       err = "garment " + std::to_string(i) + " could not be dressed on the new body (" + why + ")";
       return false;
@@ -382,16 +382,16 @@ const BodyModel& Context::restBody() {
     // proportions: a fresh builder on a body with the person's bones can plan other ones).
     restProxies_ = proxies_;
     restProxies_.build(*b, pose);
-    restChains_.clear();
-    for (const ProxySource& src : restProxies_.sources()) restChains_.push_back(static_cast<int>(src.chain));
+    restGroups_.clear();
+    for (const ProxySource& src : restProxies_.sources()) restGroups_.push_back(collisionGroups(src));
     restBody_ = std::move(b);
   }
   return *restBody_;
 }
 
-const std::vector<int>& Context::restEllipsoidChains() {
+const std::vector<uint8_t>& Context::restEllipsoidGroups() {
   restBody();
-  return restChains_;
+  return restGroups_;
 }
 
 const std::vector<Ellipsoid>& Context::restEllipsoids() {

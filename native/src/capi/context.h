@@ -50,8 +50,8 @@ class Context {
   // dressed on), built on demand and cached until the shape changes.
   const BodyModel& restBody();
   const std::vector<Ellipsoid>& restEllipsoids();
-  // The chain of each ellipsoid (same order every frame).
-  const std::vector<int>& restEllipsoidChains();
+  // The collision groups of each ellipsoid (collisionGroups of its source; same order every frame).
+  const std::vector<uint8_t>& restEllipsoidGroups();
   // Takes ownership; the garment is dressed already (GarmentSim::create with restBody()).
   GarmentSim* adoptGarment(std::unique_ptr<GarmentSim> garment);
   // Destroys it; false when it is not this context's.
@@ -110,7 +110,7 @@ class Context {
   // of them or, when one cannot be dressed on the new body, none (err says which and why).
   bool refitGarments(std::string& err, bool remake_templates);
   ProxyBuilder restProxies_;
-  std::vector<int> restChains_;
+  std::vector<uint8_t> restGroups_;
   std::vector<std::unique_ptr<GarmentSim>> garments_;
   std::vector<Ellipsoid> stepEllipsoids_;  // the ellipsoids at the end of the last step
   bool teleportPending_ = false;           // a teleport since the last step

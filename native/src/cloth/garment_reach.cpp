@@ -101,12 +101,12 @@ void markReachable(const std::vector<ReachSphere>& spheres, const std::vector<Ri
   const int ringCount = static_cast<int>(rings.size());
   for (size_t k = 0; k < reach.size() && k < sources.size(); ++k) {
     if (reach[k]) continue;
-    const uint8_t bit = static_cast<uint8_t>(1u << std::clamp(static_cast<int>(sources[k].chain), 0, kChainCount - 1));
+    const uint8_t bits = collisionGroups(sources[k]);
     const int r = std::clamp(sources[k].first_ring, 0, ringCount - 1);
     const Vec3& c = rings[static_cast<size_t>(r)].centre;
     const float bound = k < bound_radii.size() ? bound_radii[k] : std::numeric_limits<float>::infinity();
     for (const ReachSphere& s : spheres) {
-      if (!(s.groups & bit)) continue;
+      if (!(s.groups & bits)) continue;
       if (s.ring < 0 || s.ring >= ringCount ||
           (c - rings[static_cast<size_t>(s.ring)].centre).norm() < s.radius_m + bound) {
         reach[k] = 1;

@@ -139,7 +139,7 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
                                                ClothSolverKind solver, const GarmentSimParams& params,
                                                float dress_time_s, const BodyModel& body_rest,
                                                const std::vector<Ellipsoid>& rest_ellipsoids,
-                                               const std::vector<int>& ellipsoid_chains,
+                                               const std::vector<uint8_t>& ellipsoid_groups,
                                                std::string& err, bool cut_from_dressed) {
   if (std::string e = validate(params); !e.empty()) {
     err = e;
@@ -181,13 +181,11 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
     g->mesh_.pin_ring[k] = mesh.pin_ring[order[k]];
     g->mesh_.pin_local[k] = mesh.pin_local[order[k]];
   }
-  if (ellipsoid_chains.size() != rest_ellipsoids.size()) {
-    err = "one chain per ellipsoid expected";
+  if (ellipsoid_groups.size() != rest_ellipsoids.size()) {
+    err = "one collision group set per ellipsoid expected";
     return nullptr;
   }
-  g->groups_.resize(ellipsoid_chains.size());
-  for (size_t k = 0; k < ellipsoid_chains.size(); ++k)
-    g->groups_[k] = static_cast<uint8_t>(1u << std::clamp(ellipsoid_chains[k], 0, kChainCount - 1));
+  g->groups_ = ellipsoid_groups;
   g->masks_.resize(g->mesh_.positions.size());
   for (size_t i = 0; i < g->masks_.size(); ++i)
     g->masks_[i] = maskForChain(nearestChain(body_rest, g->mesh_.positions[i]));
@@ -284,12 +282,12 @@ std::unique_ptr<GarmentSim> GarmentSim::createTemplate(const GarmentTemplatePara
                                                        ClothSolverKind solver, const GarmentSimParams& params,
                                                        float dress_time_s, const BodyModel& body_rest,
                                                        const std::vector<Ellipsoid>& rest_ellipsoids,
-                                                       const std::vector<int>& ellipsoid_chains, std::string& err) {
+                                                       const std::vector<uint8_t>& ellipsoid_groups, std::string& err) {
   GarmentMesh mesh;
   TemplateLayout layout;
   if (!makeGarmentTemplate(body_rest, tmpl, mesh, err, &layout)) return nullptr;
   std::unique_ptr<GarmentSim> g =
-      create(mesh, topo, solver, params, dress_time_s, body_rest, rest_ellipsoids, ellipsoid_chains, err);
+      create(mesh, topo, solver, params, dress_time_s, body_rest, rest_ellipsoids, ellipsoid_groups, err);
   if (!g) return nullptr;
   auto origin = std::make_shared<Origin>(*g->origin_);
   origin->from_template = true;
@@ -301,7 +299,7 @@ std::unique_ptr<GarmentSim> GarmentSim::createTemplate(const GarmentTemplatePara
 
 std::unique_ptr<GarmentSim> GarmentSim::refitted(const BodyModel& body_rest,
                                                  const std::vector<Ellipsoid>& rest_ellipsoids,
-                                                 const std::vector<int>& ellipsoid_chains,
+                                                 const std::vector<uint8_t>& ellipsoid_groups,
                                                  std::string& err, bool remake_template) const {
   const Origin& o = *origin_;
   if (o.rest_rings.size() != body_rest.rings().size()) {
@@ -320,7 +318,7 @@ std::unique_ptr<GarmentSim> GarmentSim::refitted(const BodyModel& body_rest,
     if (makeGarmentTemplate(body_rest, o.tmpl, mesh, why, nullptr, &o.layout) && mesh.indices == o.mesh.indices &&
         mesh.positions.size() == o.mesh.positions.size()) {
       std::unique_ptr<GarmentSim> g = create(mesh, o.topology, kind_, params_, o.dress_time_s, body_rest,
-                                             rest_ellipsoids, ellipsoid_chains, err);
+                                             rest_ellipsoids, ellipsoid_groups, err);
       if (g) g->origin_ = origin_;
       return g;
     }
@@ -333,7 +331,7 @@ std::unique_ptr<GarmentSim> GarmentSim::refitted(const BodyModel& body_rest,
   // shrank with the body, so the old offset in metres would put the pin inside or off the body).
   pinOffsetsFromPositions(body_rest, mesh);
   std::unique_ptr<GarmentSim> g = create(mesh, o.topology, kind_, params_, o.dress_time_s, body_rest,
-                                         rest_ellipsoids, ellipsoid_chains, err, true);
+                                         rest_ellipsoids, ellipsoid_groups, err, true);
   if (g) g->origin_ = origin_;
   return g;
 }

@@ -109,8 +109,8 @@ class GarmentSim {
   // dresses the garment on `body_rest` (a BodyModel updated with its rest pose) and the ellipsoids
   // built from it: free particles pushed outside, then `dress_time_s` of settling under gravity.
   // Null + err on bad input (mesh, pins, params).
-  // ellipsoid_chains: the body chain (Chain) each ellipsoid was built from (ProxySource::chain),
-  // for the collision groups below. cut_from_dressed: the garment's rest shape becomes the shape
+  // ellipsoid_groups: each ellipsoid's collision groups (collisionGroups of its ProxySource: bit
+  // 1 << Chain per body chain it belongs to), for the collision groups below. cut_from_dressed: the garment's rest shape becomes the shape
   // it has once pushed outside the ellipsoids (without gravity), as a tailor would let it out: for
   // meshes made on another body (OBJ garments), which sit tight on that body's skin and would
   // otherwise be stretched by the ellipsoids' bulges and the collision margin.
@@ -118,7 +118,7 @@ class GarmentSim {
                                             ClothSolverKind solver, const GarmentSimParams& params,
                                             float dress_time_s, const BodyModel& body_rest,
                                             const std::vector<Ellipsoid>& rest_ellipsoids,
-                                            const std::vector<int>& ellipsoid_chains,
+                                            const std::vector<uint8_t>& ellipsoid_groups,
                                             std::string& err, bool cut_from_dressed = false);
   // A template garment: makeGarmentTemplate on body_rest, then create(). It remembers the template
   // and its layout, so refitted() cuts it again as that template on the new body.
@@ -126,7 +126,7 @@ class GarmentSim {
                                                     ClothSolverKind solver, const GarmentSimParams& params,
                                                     float dress_time_s, const BodyModel& body_rest,
                                                     const std::vector<Ellipsoid>& rest_ellipsoids,
-                                                    const std::vector<int>& ellipsoid_chains, std::string& err);
+                                                    const std::vector<uint8_t>& ellipsoid_groups, std::string& err);
   ~GarmentSim();
 
   // Refitting to a new body shape (the host changed the person's height, weight or girths while
@@ -145,7 +145,7 @@ class GarmentSim {
   // docs/garments.md, "Cut for the person's skeleton"; a shape change carries it, which measured
   // closer to a garment made for the new body there).
   std::unique_ptr<GarmentSim> refitted(const BodyModel& body_rest, const std::vector<Ellipsoid>& rest_ellipsoids,
-                                       const std::vector<int>& ellipsoid_chains, std::string& err,
+                                       const std::vector<uint8_t>& ellipsoid_groups, std::string& err,
                                        bool remake_template = false) const;
   // Takes over `fresh` (from refitted()) and keeps what identifies this garment to its owner: the
   // C ABI token and owner, its step count and glitch counters; counts the refit.

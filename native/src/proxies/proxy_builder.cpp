@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace drape {
 
@@ -20,6 +21,10 @@ const float kSectionScale = 0.995f / kMidFactor;
 // far an ellipsoid reaches past a bend or a chain end.
 constexpr float kMaxSpacingOverRadius = 1.0f;
 const float kCosBend = std::cos(25.0f * kPi / 180.0f);
+// Shoulder fills (ProxyBuilder::shoulderFill): the ellipsoid inscribed in the box of the stitch's
+// points is scaled by this, so that it fills the hollow without bulging out of the body where the
+// stitch is concave. docs/proxies.md, "Shoulder fills", has the sweep it was chosen from.
+constexpr float kShoulderFillScale = 0.75f;
 
 float ringSpacing(const BodyModel& body, int first, int count, int i) {
   const auto& rings = body.rings();
@@ -30,6 +35,87 @@ float ringSpacing(const BodyModel& body, int first, int count, int i) {
 }
 
 }  // namespace
+
+uint8_t collisionGroups(const ProxySource& source) {
+  const auto bit = [](int chain) { return static_cast<uint8_t>(1u << std::clamp(chain, 0, kChainCount - 1)); };
+  uint8_t groups = bit(static_cast<int>(source.chain));
+  if (source.also_chain >= 0) groups = static_cast<uint8_t>(groups | bit(source.also_chain));
+  return groups;
+}
+
+void ProxyBuilder::planShoulderFills(const BodyModel& body) {
+  const uint32_t K = static_cast<uint32_t>(body.ringPoints());
+  const int neck = body.chainFirstRing(Chain::Head);
+  for (int side = 0; side < 2; ++side) {
+    const bool left = side == 1;
+    ShoulderStitch& s = shoulders_[side];
+    s.junction_ring = body.chainFirstRing(left ? Chain::ArmL : Chain::ArmR);
+    std::vector<uint32_t> v(body.shoulderTriangles(left));
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+    s.neck.clear();
+    s.junction.clear();
+    for (uint32_t i : v) {
+      const int ring = static_cast<int>(i / K);
+      if (ring == s.junction_ring) s.junction.push_back(i);
+      if (ring == neck) s.neck.push_back(i);
+    }
+  }
+  shouldersPlanned_ = true;
+}
+
+// The stitch between a shoulder's torso loop (the top torso ring's side arc, at the armpit, going
+// up into the neck ring's side arc) and the arm's junction ring is a tent of triangles that no
+// ring ellipsoid covers: the top of the shoulder, from the base of the neck out to the shoulder
+// joint. Cloth lying on the ring ellipsoids sank up to 2 cm into the body mesh there, in still
+// frames too (the T-shirt's yoke beside its seam pins). The fill is the ellipsoid inscribed in the
+// box of the points of the neck ring's arc and of the junction ring, scaled by
+// kShoulderFillScale, in a frame that follows the body (y from the arc's centroid to the
+// shoulder joint, x the top torso ring's forward). The armpit half of the stitch is left out: a
+// fill over the whole stitch reaches down into the armpit, where cloth caught between arm and
+// torso hangs, and raised the stretch; a frame from the points' principal axes swaps axes when
+// two spreads cross, which kicked the cloth (docs/proxies.md, "Shoulder fills").
+Ellipsoid ProxyBuilder::shoulderFill(const BodyModel& body, const ShoulderStitch& s) const {
+  const auto& rings = body.rings();
+  const int K = body.ringPoints();
+  // Ring point v = r * K + j, placed as BodyModel::writeVertices places it (the mesh itself may
+  // not be updated this frame: capi/adaptive.h).
+  const auto point = [&](uint32_t v) {
+    const RingPose& r = rings[v / static_cast<uint32_t>(K)];
+    const float theta = 2.0f * kPi * static_cast<float>(v % static_cast<uint32_t>(K)) / static_cast<float>(K);
+    return Vec3(r.centre + std::cos(theta) * (r.frame.col(0) * r.forward_m) +
+                std::sin(theta) * (r.frame.col(2) * r.side_m));
+  };
+  const RingPose& junction = rings[static_cast<size_t>(s.junction_ring)];
+  const RingPose& top = rings[static_cast<size_t>(body.chainFirstRing(Chain::Torso) +
+                                                  body.chainRingCount(Chain::Torso) - 1)];
+  Vec3 c = Vec3::Zero();
+  for (uint32_t v : s.neck) c += point(v);
+  c /= static_cast<float>(std::max<size_t>(s.neck.size(), 1));
+  Vec3 y = junction.centre - c;
+  y = y.norm() > 1e-6f ? Vec3(y.normalized()) : Vec3(junction.frame.col(1));
+  Vec3 x = top.frame.col(0) - top.frame.col(0).dot(y) * y;
+  if (x.norm() < 1e-6f) x = top.frame.col(2) - top.frame.col(2).dot(y) * y;
+  x.normalize();
+  Mat3 R;
+  R.col(0) = x;
+  R.col(1) = y;
+  R.col(2) = x.cross(y);
+  Vec3 lo = Vec3::Constant(std::numeric_limits<float>::infinity()), hi = -lo;
+  for (const std::vector<uint32_t>* part : {&s.neck, &s.junction}) {
+    for (uint32_t v : *part) {
+      const Vec3 q = R.transpose() * (point(v) - c);
+      lo = lo.cwiseMin(q);
+      hi = hi.cwiseMax(q);
+    }
+  }
+  if (!(lo.array() <= hi.array()).all()) lo = hi = Vec3::Zero();  // no points (not for a valid body)
+  Ellipsoid e;
+  e.centre = c + R * (0.5f * (lo + hi));
+  e.rotation = R;
+  e.radii = (kShoulderFillScale * 0.5f * (hi - lo)).cwiseMax(Vec3::Constant(1e-3f));
+  return e;
+}
 
 void ProxyBuilder::planSubRings(const BodyModel& body) {
   // Decided once, on the rings as first built, so the ellipsoid count never changes.
@@ -95,6 +181,7 @@ void ProxyBuilder::buildAll(const BodyModel& body, const SkeletonPose& pose) {
   count_ = 0;
   built_ = 0;
   if (subRings_.empty()) planSubRings(body);
+  if (!shouldersPlanned_) planShoulderFills(body);
   const auto& rings = body.rings();
   const bool paper = rule_ == ProxyRule::Paper;
 
@@ -223,6 +310,14 @@ void ProxyBuilder::buildAll(const BodyModel& body, const SkeletonPose& pose) {
       e.radii = Vec3(std::max(0.45f * r.forward_m, 1e-3f), std::max(0.52f * len, 1e-3f),
                      std::max(0.45f * r.side_m, 1e-3f));
       add(e, {ends[a], last, -1});
+    }
+    // Shoulder fills (shoulderFill above), right then left.
+    for (int side = 0; side < 2; ++side) {
+      const ShoulderStitch& s = shoulders_[side];
+      const ProxySource src{side == 1 ? Chain::ArmL : Chain::ArmR, s.junction_ring, -1,
+                            static_cast<int>(Chain::Torso)};
+      if (skipNext(src)) continue;
+      add(shoulderFill(body, s), src);
     }
   }
   // ellipsoids_ never shrinks (no allocation per frame); the live count is count_.

@@ -8,8 +8,9 @@
 //  - Drape (default): one ellipsoid per ring and per sub-ring interpolated where rings are
 //    further apart than the local radius; long semi-axis = kOverlap x the larger neighbour
 //    spacing and cross-section scaled so the union neither dips between rings nor bulges at them
-//    by more than ~3 %; chain ends and bends reach only to their neighbour (docs/proxies.md has
-//    the derivation and the measured before/after).
+//    by more than ~3 %; chain ends and bends reach only to their neighbour; after the ring
+//    ellipsoids, a slim cap per chain end and a fill per shoulder (docs/proxies.md has the
+//    derivation and the measured before/after).
 #pragma once
 
 #include "body/body_model.h"
@@ -26,7 +27,15 @@ struct ProxySource {
   Chain chain = Chain::Torso;
   int first_ring = 0;  // ring (or first ring of the bone) it was built from
   int bone = -1;       // bone of the chain for per-bone ellipsoids, else -1
+  // A second chain whose cloth collides with it too, or -1. The shoulder fills (chain = the arm,
+  // first_ring = its junction ring) cover the stitch between the torso and the arm, which lies
+  // under the yoke as much as under the sleeve, so they also count as the torso's.
+  int also_chain = -1;
 };
+
+// The collision groups of an ellipsoid (bit 1 << chain per chain it belongs to): what cloth
+// collision groups (GarmentSim) and the garments' reach (cloth/garment_reach.h) test against.
+uint8_t collisionGroups(const ProxySource& source);
 
 class ProxyBuilder {
  public:
@@ -59,6 +68,17 @@ class ProxyBuilder {
   // Ellipsoid index range of each chain's ring ellipsoids (Drape rule), from the first build.
   size_t chainFirst_[kChainCount] = {}, chainCount_[kChainCount] = {};
   void planSubRings(const BodyModel& body);
+  // Shoulder fills (Drape rule): the ring points (ring * K + j) of each shoulder's stitch
+  // (body_topology.cpp) on the neck ring and on the arm's junction ring; found once, from the
+  // body's fixed topology, so a frame allocates nothing.
+  struct ShoulderStitch {
+    std::vector<uint32_t> neck, junction;
+    int junction_ring = 0;
+  };
+  void planShoulderFills(const BodyModel& body);
+  Ellipsoid shoulderFill(const BodyModel& body, const ShoulderStitch& stitch) const;
+  ShoulderStitch shoulders_[2];  // right, left
+  bool shouldersPlanned_ = false;
   std::vector<int> subRings_;        // per ring: sub-rings inserted before the next ring
   std::vector<RingPose> scratch_;    // one chain's rings and sub-rings
   std::vector<int> scratchRing_;     // the ring each of them belongs to

@@ -135,7 +135,7 @@ bool makeSide(Side& s, GarmentKind kind, int particles, bool adaptive, std::stri
   GarmentMesh mesh;
   if (!makeGarmentTemplate(s.ctx->restBody(), tp, mesh, err)) return false;
   auto g = GarmentSim::create(mesh, TopologyParams{}, ClothSolverKind::Xpbd, GarmentSimParams{}, 0.5f,
-                              s.ctx->restBody(), s.ctx->restEllipsoids(), s.ctx->restEllipsoidChains(), err);
+                              s.ctx->restBody(), s.ctx->restEllipsoids(), s.ctx->restEllipsoidGroups(), err);
   if (!g) return false;
   s.garment = s.ctx->adoptGarment(std::move(g));
   return true;
