@@ -360,3 +360,6 @@ static_assert(sizeof(drape_skeleton_frame) == 24 + 2 * sizeof(void*), "drape_ske
 static_assert(sizeof(drape_frame_stats) == 72, "drape_frame_stats layout");
 static_assert(sizeof(drape_recording_info) == 32, "drape_recording_info layout");
 static_assert(sizeof(drape_result) == 4, "enums are 32-bit");
+
+// File-local (capi_garments.cpp defines its own; the sanitizer tree compiles both in one batch).
+#undef DRAPE_CHECK_CONTEXT
