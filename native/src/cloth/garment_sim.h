@@ -110,7 +110,8 @@ class GarmentSim {
   // built from it: free particles pushed outside, then `dress_time_s` of settling under gravity.
   // Null + err on bad input (mesh, pins, params).
   // ellipsoid_groups: each ellipsoid's collision groups (collisionGroups of its ProxySource: bit
-  // 1 << Chain per body chain it belongs to), for the collision groups below. cut_from_dressed: the garment's rest shape becomes the shape
+  // 1 << Chain per body chain it belongs to), for the collision groups below. cut_from_dressed:
+  // the garment's rest shape becomes the shape
   // it has once pushed outside the ellipsoids (without gravity), as a tailor would let it out: for
   // meshes made on another body (OBJ garments), which sit tight on that body's skin and would
   // otherwise be stretched by the ellipsoids' bulges and the collision margin.

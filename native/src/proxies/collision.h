@@ -85,8 +85,8 @@ class EllipsoidCollider {
 
   int count() const { return static_cast<int>(shapes_.size()); }
 
-  // Collision groups. ellipsoid_groups: one bit set per ellipsoid (its group, e.g. 1 << body
-  // chain), in the order setEllipsoids receives them; particle_masks: one byte per particle, the
+  // Collision groups. ellipsoid_groups: the groups of each ellipsoid (bits 1 << body chain: one,
+  // or two for the shoulder fills, proxies/proxy_builder.h), in the order setEllipsoids receives them; particle_masks: one byte per particle, the
   // groups it collides with (kept by the caller, read by collide() for particle i = masks[i]).
   // A particle never collides with an ellipsoid outside its mask. Empty groups or null masks: every
   // particle collides with every ellipsoid. Needs count() <= kMaxGridEllipsoids at collide time
