@@ -23,10 +23,10 @@ struct Take {
   int max_off;      // frames with an opening off its body part allowed, -1 = not checked
                     // (docs/garments.md, "Openings": on Ges01 the waving arm leaves its sleeve,
                     // on the CMU takes the sleeves are off the bent arms; those are measured, not
-                    // yet fixed). Close range: the hands reach under the hem at the hips (torso
-                    // cloth does not collide with the arms' ellipsoids) and the hem's linking round
-                    // the spine dips to the threshold: 2 of 371 frames (around frame 52) since the shoulder
-                    // fills (docs/proxies.md), none before
+                    // yet fixed). Close range: 2 of 371 frames (around frame 52) since the
+                    // shoulder fills (docs/proxies.md), none before; the renders of frames 51-53
+                    // show the hands through the hem at the hips (torso cloth does not collide
+                    // with the arms' ellipsoids)
 };
 
 const Take kTakes[] = {

@@ -128,8 +128,9 @@ TEST_P(Backends, ClothOnAStillBodyComesToRest) {
   Scene s;
   makeScene(s);
   std::vector<Eigen::Vector4f> before;
-  // 2 s: since the shoulder fills (docs/proxies.md) a few particles of the 600-particle T-shirt's
-  // first rows (the hem) still move ~2 mm a frame at 1.5 s, 1 mm at 2 s, 0.3-0.6 mm at 3.5 s.
+  // 2 s: since the shoulder fills (docs/proxies.md) a few particles of the T-shirt's first rows
+  // (its hem; 600 particles requested) still move ~2 mm a frame at 1.5 s, 1 mm at 2 s, 0.3-0.6 mm
+  // at 3.5 s.
   for (int f = 0; f < 60; ++f) {
     if (f == 59) before.assign(s.garment->positions(), s.garment->positions() + s.garment->particleCount());
     stepPose(*s.ctx, s.rest, f / 30.0, 1.0f / 30.0f);
