@@ -85,12 +85,16 @@ TEST_P(ProxyCulling, BuildsOnlyWhatTheGarmentReaches) {
   }
   std::printf("[ figures  ] garment %d: %u of %u ellipsoids built:", static_cast<int>(GetParam().kind), c.proxies_built,
               c.proxies_available);
+  // Per chain, and the shoulder fills (two chains each, ProxySource::also_chain) apart.
   const auto& sources = ctx.proxies().sources();
-  for (int ch = 0; ch < kChainCount; ++ch) {
+  auto isFill = [&](size_t k) { return sources[k].also_chain >= 0; };
+  for (int ch = -1; ch < kChainCount; ++ch) {
+    auto counts = [&](size_t k) { return ch < 0 ? isFill(k) : !isFill(k) && static_cast<int>(sources[k].chain) == ch; };
     int n = 0, of = 0;
-    for (size_t k = 0; k < sources.size(); ++k) of += static_cast<int>(sources[k].chain) == ch ? 1 : 0;
-    for (int k : g->reachable()) n += static_cast<int>(sources[static_cast<size_t>(k)].chain) == ch ? 1 : 0;
-    std::printf(" %s %d/%d", chainName(static_cast<Chain>(ch)), n, of);
+    for (size_t k = 0; k < sources.size(); ++k) of += counts(k) ? 1 : 0;
+    for (int k : g->reachable()) n += counts(static_cast<size_t>(k)) ? 1 : 0;
+    if (ch >= 0) std::printf(" %s %d/%d", chainName(static_cast<Chain>(ch)), n, of);
+    else std::printf(" shoulder_fills %d/%d;", n, of);
   }
   std::printf("\n");
 }

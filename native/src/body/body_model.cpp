@@ -294,12 +294,10 @@ void BodyModel::writeVertices() {
   const int K = K_;
   for (size_t r = 0; r < rings_.size(); ++r) {
     const RingPose& rp = rings_[r];
-    const Vec3 ax = rp.frame.col(0) * rp.forward_m;
-    const Vec3 az = rp.frame.col(2) * rp.side_m;
     Vec3* out = &positions_[r * static_cast<size_t>(K)];
     for (int j = 0; j < K; ++j) {
       const float theta = 2.0f * kPi * static_cast<float>(j) / static_cast<float>(K);
-      out[j] = rp.centre + std::cos(theta) * ax + std::sin(theta) * az;
+      out[j] = ringPointAt(rp, std::cos(theta), std::sin(theta));
     }
   }
   // Crotch bridge: from the front-centre point of the hip ring to its back-centre point, sagging

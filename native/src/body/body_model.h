@@ -56,6 +56,12 @@ struct RingPose {
   float side_m = 0.0f;
 };
 
+// The point of ring `r` at the angle whose cosine and sine are c and s, from the frame's x
+// (forward) towards its z: where the body mesh puts its ring vertices (angles 2 pi j / K).
+inline Vec3 ringPointAt(const RingPose& r, float c, float s) {
+  return r.centre + c * (r.frame.col(0) * r.forward_m) + s * (r.frame.col(2) * r.side_m);
+}
+
 class BodyModel {
  public:
   // Builds rings and the fixed topology. Params must be valid (checked by the caller).

@@ -111,10 +111,10 @@ class GarmentSim {
   // Null + err on bad input (mesh, pins, params).
   // ellipsoid_groups: each ellipsoid's collision groups (collisionGroups of its ProxySource: bit
   // 1 << Chain per body chain it belongs to), for the collision groups below. cut_from_dressed:
-  // the garment's rest shape becomes the shape
-  // it has once pushed outside the ellipsoids (without gravity), as a tailor would let it out: for
-  // meshes made on another body (OBJ garments), which sit tight on that body's skin and would
-  // otherwise be stretched by the ellipsoids' bulges and the collision margin.
+  // the garment's rest shape becomes the shape it has once pushed outside the ellipsoids (without
+  // gravity), as a tailor would let it out: for meshes made on another body (OBJ garments), which
+  // sit tight on that body's skin and would otherwise be stretched by the ellipsoids' bulges and
+  // the collision margin.
   static std::unique_ptr<GarmentSim> create(const GarmentMesh& mesh, const TopologyParams& topo,
                                             ClothSolverKind solver, const GarmentSimParams& params,
                                             float dress_time_s, const BodyModel& body_rest,

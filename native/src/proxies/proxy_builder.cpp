@@ -44,7 +44,7 @@ uint8_t collisionGroups(const ProxySource& source) {
 }
 
 void ProxyBuilder::planShoulderFills(const BodyModel& body) {
-  const uint32_t K = static_cast<uint32_t>(body.ringPoints());
+  const int K = body.ringPoints();
   const int neck = body.chainFirstRing(Chain::Head);
   for (int side = 0; side < 2; ++side) {
     const bool left = side == 1;
@@ -56,12 +56,14 @@ void ProxyBuilder::planShoulderFills(const BodyModel& body) {
     s.neck.clear();
     s.junction.clear();
     for (uint32_t i : v) {
-      const int ring = static_cast<int>(i / K);
-      if (ring == s.junction_ring) s.junction.push_back(i);
-      if (ring == neck) s.neck.push_back(i);
+      // Ring vertex i = ring * K + j, at angle 2 pi j / K (BodyModel::writeVertices).
+      const int ring = static_cast<int>(i) / K;
+      const float theta = 2.0f * kPi * static_cast<float>(static_cast<int>(i) % K) / static_cast<float>(K);
+      const StitchPoint p{ring, std::cos(theta), std::sin(theta)};
+      if (ring == s.junction_ring) s.junction.push_back(p);
+      if (ring == neck) s.neck.push_back(p);
     }
   }
-  shouldersPlanned_ = true;
 }
 
 // The stitch between a shoulder's torso loop (the top torso ring's side arc, at the armpit, going
@@ -72,25 +74,19 @@ void ProxyBuilder::planShoulderFills(const BodyModel& body) {
 // box of the points of the neck ring's arc and of the junction ring, scaled by
 // kShoulderFillScale, in a frame that follows the body (y from the arc's centroid to the
 // shoulder joint, x the top torso ring's forward). The armpit half of the stitch is left out: a
-// fill over the whole stitch reaches down into the armpit, where cloth caught between arm and
-// torso hangs, and raised the stretch; a frame from the points' principal axes swaps axes when
-// two spreads cross, which kicked the cloth (docs/proxies.md, "Shoulder fills").
+// fill over the whole stitch raised the stretch (as we read it, it reaches down into the armpit,
+// where cloth caught between arm and torso hangs); a frame from the points' principal axes (which
+// can swap when two spreads cross) stretched the T-shirt far more (docs/proxies.md, "Shoulder
+// fills").
 Ellipsoid ProxyBuilder::shoulderFill(const BodyModel& body, const ShoulderStitch& s) const {
   const auto& rings = body.rings();
-  const int K = body.ringPoints();
-  // Ring point v = r * K + j, placed as BodyModel::writeVertices places it (the mesh itself may
-  // not be updated this frame: capi/adaptive.h).
-  const auto point = [&](uint32_t v) {
-    const RingPose& r = rings[v / static_cast<uint32_t>(K)];
-    const float theta = 2.0f * kPi * static_cast<float>(v % static_cast<uint32_t>(K)) / static_cast<float>(K);
-    return Vec3(r.centre + std::cos(theta) * (r.frame.col(0) * r.forward_m) +
-                std::sin(theta) * (r.frame.col(2) * r.side_m));
-  };
+  // From the rings, not the mesh, which may not be updated this frame (capi/adaptive.h).
+  const auto point = [&](const StitchPoint& p) { return ringPointAt(rings[static_cast<size_t>(p.ring)], p.c, p.s); };
   const RingPose& junction = rings[static_cast<size_t>(s.junction_ring)];
   const RingPose& top = rings[static_cast<size_t>(body.chainFirstRing(Chain::Torso) +
                                                   body.chainRingCount(Chain::Torso) - 1)];
   Vec3 c = Vec3::Zero();
-  for (uint32_t v : s.neck) c += point(v);
+  for (const StitchPoint& p : s.neck) c += point(p);
   c /= static_cast<float>(std::max<size_t>(s.neck.size(), 1));
   Vec3 y = junction.centre - c;
   y = y.norm() > 1e-6f ? Vec3(y.normalized()) : Vec3(junction.frame.col(1));
@@ -102,9 +98,9 @@ Ellipsoid ProxyBuilder::shoulderFill(const BodyModel& body, const ShoulderStitch
   R.col(1) = y;
   R.col(2) = x.cross(y);
   Vec3 lo = Vec3::Constant(std::numeric_limits<float>::infinity()), hi = -lo;
-  for (const std::vector<uint32_t>* part : {&s.neck, &s.junction}) {
-    for (uint32_t v : *part) {
-      const Vec3 q = R.transpose() * (point(v) - c);
+  for (const std::vector<StitchPoint>* part : {&s.neck, &s.junction}) {
+    for (const StitchPoint& p : *part) {
+      const Vec3 q = R.transpose() * (point(p) - c);
       lo = lo.cwiseMin(q);
       hi = hi.cwiseMax(q);
     }
@@ -181,7 +177,7 @@ void ProxyBuilder::buildAll(const BodyModel& body, const SkeletonPose& pose) {
   count_ = 0;
   built_ = 0;
   if (subRings_.empty()) planSubRings(body);
-  if (!shouldersPlanned_) planShoulderFills(body);
+  if (shoulders_[0].junction.empty()) planShoulderFills(body);
   const auto& rings = body.rings();
   const bool paper = rule_ == ProxyRule::Paper;
 

@@ -68,17 +68,21 @@ class ProxyBuilder {
   // Ellipsoid index range of each chain's ring ellipsoids (Drape rule), from the first build.
   size_t chainFirst_[kChainCount] = {}, chainCount_[kChainCount] = {};
   void planSubRings(const BodyModel& body);
-  // Shoulder fills (Drape rule): the ring points (ring * K + j) of each shoulder's stitch
-  // (body_topology.cpp) on the neck ring and on the arm's junction ring; found once, from the
-  // body's fixed topology, so a frame allocates nothing.
+  // Shoulder fills (Drape rule): the ring points of each shoulder's stitch (body_topology.cpp) on
+  // the neck ring and on the arm's junction ring, as their ring and the cosine and sine of their
+  // angle (ringPointAt); found once, from the body's fixed topology, so a frame allocates nothing
+  // and computes no angle.
+  struct StitchPoint {
+    int ring = 0;
+    float c = 1.0f, s = 0.0f;
+  };
   struct ShoulderStitch {
-    std::vector<uint32_t> neck, junction;
+    std::vector<StitchPoint> neck, junction;
     int junction_ring = 0;
   };
   void planShoulderFills(const BodyModel& body);
   Ellipsoid shoulderFill(const BodyModel& body, const ShoulderStitch& stitch) const;
-  ShoulderStitch shoulders_[2];  // right, left
-  bool shouldersPlanned_ = false;
+  ShoulderStitch shoulders_[2];  // right, left; empty until the first build
   std::vector<int> subRings_;        // per ring: sub-rings inserted before the next ring
   std::vector<RingPose> scratch_;    // one chain's rings and sub-rings
   std::vector<int> scratchRing_;     // the ring each of them belongs to
