@@ -460,6 +460,13 @@ drape_result Context::beginStep(float dt, std::string& err) {
   adaptive_.advance(dt);
   size_t slept = 0;
   stepping_.clear();
+  // Torso cloth meets a leg only while the sensor tracks its hip and knee (GarmentSim::
+  // setLegsTrusted): an inferred leg is a guess.
+  const SkeletonPose& tracked = tracker_.pose();
+  const auto trusted = [&](Joint hip, Joint knee) {
+    return tracked.state[idx(hip)] == TrackingState::Tracked && tracked.state[idx(knee)] == TrackingState::Tracked;
+  };
+  const bool left_leg = trusted(Joint::HipL, Joint::KneeL), right_leg = trusted(Joint::HipR, Joint::KneeR);
   for (auto& g : garments_) {
     if (options_.sleep && adaptive_.asleep(g.get())) {
       g->markSkipped();
@@ -468,6 +475,7 @@ drape_result Context::beginStep(float dt, std::string& err) {
     }
     const std::vector<Ellipsoid>* woke = adaptive_.wakeStart(g.get(), now);
     g->setTrackingNoise(tracker_.noiseSigmaM());  // noise bursts: garment_recovery.cpp
+    g->setLegsTrusted(left_leg, right_leg);
     // Device frames are only staged here: the caller runs them all together (runStagedFrames).
     g->stepBegin(*body_, woke ? *woke : stepEllipsoids_, now, dt, teleportPending_, true);
     stepping_.push_back(g.get());

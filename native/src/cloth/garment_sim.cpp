@@ -140,7 +140,8 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
                                                float dress_time_s, const BodyModel& body_rest,
                                                const std::vector<Ellipsoid>& rest_ellipsoids,
                                                const std::vector<uint8_t>& ellipsoid_groups,
-                                               std::string& err, bool cut_from_dressed) {
+                                               std::string& err, bool cut_from_dressed,
+                                               bool torso_meets_legs) {
   if (std::string e = validate(params); !e.empty()) {
     err = e;
     return nullptr;
@@ -185,11 +186,12 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
     err = "one collision group set per ellipsoid expected";
     return nullptr;
   }
+  g->base_groups_ = ellipsoid_groups;
   g->groups_ = ellipsoid_groups;
   g->masks_.resize(g->mesh_.positions.size());
   for (size_t i = 0; i < g->masks_.size(); ++i)
-    g->masks_[i] = maskForChain(nearestChain(body_rest, g->mesh_.positions[i]));
-  g->collider_.setGroups(g->groups_, g->masks_.data());
+    g->masks_[i] = maskFor(body_rest, g->mesh_.positions[i], torso_meets_legs);
+  g->setLegsTrusted(true, true);  // the rest body's legs, where the garment is dressed outside them
   g->kind_ = solver;
   g->solver_ = makeSolver(solver, g->topology_);
   if (!g->setParams(params, err)) return nullptr;
@@ -286,8 +288,8 @@ std::unique_ptr<GarmentSim> GarmentSim::createTemplate(const GarmentTemplatePara
   GarmentMesh mesh;
   TemplateLayout layout;
   if (!makeGarmentTemplate(body_rest, tmpl, mesh, err, &layout)) return nullptr;
-  std::unique_ptr<GarmentSim> g =
-      create(mesh, topo, solver, params, dress_time_s, body_rest, rest_ellipsoids, ellipsoid_groups, err);
+  std::unique_ptr<GarmentSim> g = create(mesh, topo, solver, params, dress_time_s, body_rest, rest_ellipsoids,
+                                         ellipsoid_groups, err, false, /*torso_meets_legs=*/true);
   if (!g) return nullptr;
   auto origin = std::make_shared<Origin>(*g->origin_);
   origin->from_template = true;
@@ -348,6 +350,79 @@ void GarmentSim::replaceWith(GarmentSim&& fresh) {
   steps_ = steps;
   jump_restores_ = jumps;
   burst_restores_ = bursts;
+}
+
+uint8_t GarmentSim::maskFor(const BodyModel& body, const Vec3& p, bool torso_meets_legs) {
+  const int chain = nearestChain(body, p);
+  uint8_t mask = maskForChain(chain);
+  if (torso_meets_legs && static_cast<Chain>(chain) == Chain::Torso) {
+    // The leg on its side: the nearer thigh ring. One leg only: cloth between the thighs meeting
+    // both would be caught between them.
+    const Vec3& l = body.rings()[static_cast<size_t>(body.chainFirstRing(Chain::LegL))].centre;
+    const Vec3& r = body.rings()[static_cast<size_t>(body.chainFirstRing(Chain::LegR))].centre;
+    mask = static_cast<uint8_t>(mask | ((p - l).squaredNorm() < (p - r).squaredNorm() ? kTorsoOverLegL : kTorsoOverLegR));
+  }
+  return mask;
+}
+
+void GarmentSim::setLegsTrusted(bool left, bool right) {
+  const bool now[2] = {left, right};
+  for (int side = 0; side < 2; ++side) {
+    // Trusted again: the leg may have moved into the torso cloth while it was not met (an
+    // inferred leg is guessed anywhere), so its ellipsoids are checked as after a placement.
+    if (now[side] && !host_legs_[side] && tracked_) recheck_legs_ |= static_cast<uint8_t>(1u << side);
+    host_legs_[side] = now[side];
+  }
+  applyLegGroups();
+}
+
+void GarmentSim::applyLegGroups() {
+  const uint8_t legBit[2] = {static_cast<uint8_t>(1u << static_cast<int>(Chain::LegL)),
+                             static_cast<uint8_t>(1u << static_cast<int>(Chain::LegR))};
+  const uint8_t overBit[2] = {kTorsoOverLegL, kTorsoOverLegR};
+  bool changed = false;
+  for (size_t k = 0; k < groups_.size() && k < base_groups_.size(); ++k) {
+    uint8_t g = base_groups_[k];
+    const bool clear = k >= leg_clear_.size() || leg_clear_[k];
+    for (int side = 0; side < 2; ++side)
+      if (clear && host_legs_[side] && (g & legBit[side])) g = static_cast<uint8_t>(g | overBit[side]);
+    changed = changed || groups_[k] != g;
+    groups_[k] = g;
+  }
+  if (!changed) return;
+  for (size_t i = 0; i < reach_.size(); ++i) reach_groups_[i] = groups_[static_cast<size_t>(reach_[i])];
+  collider_.setGroups(reach_.empty() ? groups_ : reach_groups_, masks_.data());
+}
+
+bool GarmentSim::torsoClothInside(const Ellipsoid& e, uint8_t over) const {
+  const Eigen::Vector4f* x = solver_->x();
+  const size_t n = std::min(particleCount(), masks_.size());
+  const float r = e.radii.maxCoeff();
+  for (size_t i = 0; i < n; ++i) {
+    if (!(masks_[i] & over)) continue;
+    const Vec3 p = x[i].head<3>();
+    if ((p - e.centre).squaredNorm() < r * r && e.implicit(p) < 0.0f) return true;
+  }
+  return false;
+}
+
+void GarmentSim::updateLegClearance(const std::vector<Ellipsoid>& ellipsoids, uint8_t recheck_sides) {
+  if (unclear_legs_ == 0 && recheck_sides == 0) return;
+  const uint8_t legL = static_cast<uint8_t>(1u << static_cast<int>(Chain::LegL));
+  const uint8_t legR = static_cast<uint8_t>(1u << static_cast<int>(Chain::LegR));
+  if (leg_clear_.size() != base_groups_.size()) leg_clear_.assign(base_groups_.size(), 1);
+  for (size_t k = 0; k < ellipsoids.size(); ++k) {
+    const size_t global = reach_.empty() ? k : static_cast<size_t>(reach_[k]);
+    if (global >= base_groups_.size() || !(base_groups_[global] & (legL | legR))) continue;
+    const int side = (base_groups_[global] & legL) ? 0 : 1;
+    const bool recheck = (recheck_sides >> side) & 1u;
+    if (leg_clear_[global] && !recheck) continue;  // met: nothing to decide
+    const bool holds = torsoClothInside(ellipsoids[k], side == 0 ? kTorsoOverLegL : kTorsoOverLegR);
+    if (holds == !leg_clear_[global]) continue;
+    leg_clear_[global] = holds ? 0 : 1;
+    unclear_legs_ = holds ? unclear_legs_ + 1 : unclear_legs_ - 1;
+  }
+  applyLegGroups();
 }
 
 uint8_t GarmentSim::maskForChain(int chain) {
@@ -447,6 +522,10 @@ void GarmentSim::placeOnBody(const BodyModel& body, const std::vector<Ellipsoid>
   skin_.place(body, scratch3_);
   std::string err;
   solver_->reset(scratch3_, err);
+  // Placed on a pose the legs may already be in (a person seated from the first frame: the
+  // shirt's hem through the thighs): a leg ellipsoid that holds torso cloth now meets it only
+  // once it holds none (updateLegClearance); pushed out at once, the hem tore.
+  updateLegClearance(ellipsoids, 3);
   pinTargets(body, pins_);
   const int frames = static_cast<int>(std::ceil(params_.blend_in_s / kSettleFrameS - 1e-4f));
   for (int f = 0; f < frames; ++f) runFrame(ellipsoids, ellipsoids, pins_, kSettleFrameS);
@@ -507,6 +586,10 @@ void GarmentSim::stepBegin(const BodyModel& body, const std::vector<Ellipsoid>& 
   const RingPose& pr = body.rings()[static_cast<size_t>(pelvis_ring_)];
   pending_body_ = &body;
   pending_end_ = &end;
+  if (tracked_) {
+    updateLegClearance(start, recheck_legs_);
+    recheck_legs_ = 0;
+  }
   const bool burst_ended = tracked_ && noiseBurstEnded();
   if (!tracked_ || poseJumped(pr, dt)) {
     // First frame, or a pose no body reaches in dt from the last one (a skeleton flipped upside
@@ -516,6 +599,7 @@ void GarmentSim::stepBegin(const BodyModel& body, const std::vector<Ellipsoid>& 
       if (tracked_) keepBeforeJump(start);
       placeOnBody(body, end);
     } else {
+      updateLegClearance(end, 3);
       ++jump_restores_;
     }
     tracked_ = true;

@@ -24,6 +24,7 @@
 #include "cloth/xpbd_solver.h"
 #include "proxies/collision.h"
 #include "proxies/mesh_bvh.h"
+#include "proxies/proxy_builder.h"
 
 #include <chrono>
 #include <functional>
@@ -120,7 +121,8 @@ class GarmentSim {
                                             float dress_time_s, const BodyModel& body_rest,
                                             const std::vector<Ellipsoid>& rest_ellipsoids,
                                             const std::vector<uint8_t>& ellipsoid_groups,
-                                            std::string& err, bool cut_from_dressed = false);
+                                            std::string& err, bool cut_from_dressed = false,
+                                            bool torso_meets_legs = false);
   // A template garment: makeGarmentTemplate on body_rest, then create(). It remembers the template
   // and its layout, so refitted() cuts it again as that template on the new body.
   static std::unique_ptr<GarmentSim> createTemplate(const GarmentTemplateParams& tmpl, const TopologyParams& topo,
@@ -190,7 +192,22 @@ class GarmentSim {
   // between them has no place outside both; with groups, sleeve and torso cloth each stay on
   // their own part instead of being squeezed out through one of them.
   const std::vector<uint8_t>& particleMasks() const { return masks_; }
+  // Each ellipsoid's collision groups now (the ones given to create, plus kTorsoOverLegL / R on
+  // the leg ellipsoids torso cloth meets this step).
+  const std::vector<uint8_t>& ellipsoidGroups() const { return groups_; }
   static uint8_t maskForChain(int chain);
+  // Torso cloth of a template garment (create's torso_meets_legs) also collides with the leg on
+  // its side, through the group bits kTorsoOverLegL / R (proxies/proxy_builder.h), which a leg's
+  // ellipsoids carry only while that leg is trusted (setLegsTrusted). Why: a shirt's hem hangs over the tops of
+  // the thighs, and when the hip bent (the CMU hop takes) the thighs rose through it, the deepest
+  // body penetration of the shared takes (docs/garments.md, "Torso cloth on the thighs"). Why
+  // not always: a leg the sensor only infers (a person close to a Kinect, legs out of view) is
+  // guessed, and pushed through the shirt it tore it; and an OBJ garment's torso cloth may be a
+  // suit's seat, which on a heavy body tore between the hip and thigh ellipsoids.
+  static uint8_t maskFor(const BodyModel& body, const Vec3& p, bool torso_meets_legs);
+  // Whether each leg's ellipsoids are trusted this frame (Context: hip and knee Tracked); while
+  // one is not, torso cloth passes through it as before. Cheap when nothing changed.
+  void setLegsTrusted(bool left, bool right);
   static int nearestChain(const BodyModel& body, const Vec3& p);
 
   // Proxy culling (capi/adaptive.h): the indices (increasing) of the ellipsoids the garment can
@@ -314,7 +331,21 @@ class GarmentSim {
   GarmentSimParams params_;
   std::unique_ptr<Solver> solver_;
   EllipsoidCollider collider_;
-  std::vector<uint8_t> masks_, groups_;
+  std::vector<uint8_t> masks_, groups_;  // groups_: base_groups_ with the trusted legs' kTorsoOverLeg bits
+  std::vector<uint8_t> base_groups_;      // each ellipsoid's collision groups, as given to create()
+  // Torso cloth meets a leg's ellipsoid while the host trusts that leg (setLegsTrusted) and the
+  // ellipsoid is clear: it held no torso cloth when the garment was last placed on the body (first
+  // frame, pose jump) or when the leg was last trusted again, or none since (leg_clear_, one entry
+  // per ellipsoid; empty: all clear). Pushed out at once, cloth a leg had passed into tore.
+  bool host_legs_[2] = {true, true};
+  uint8_t recheck_legs_ = 0;  // bit per side: trusted again since the last step
+  std::vector<uint8_t> leg_clear_;
+  size_t unclear_legs_ = 0;
+  void applyLegGroups();
+  bool torsoClothInside(const Ellipsoid& e, uint8_t over) const;
+  // The reachable `ellipsoids` (this step's): an unclear leg ellipsoid becomes clear once it holds
+  // no torso cloth; those of the sides in recheck_sides (bit 0 left, 1 right) are decided anew.
+  void updateLegClearance(const std::vector<Ellipsoid>& ellipsoids, uint8_t recheck_sides);
 
   // The pelvis ring pose the garment saw at the end of its last step (inertia scaling, teleports).
   int pelvis_ring_ = 0;

@@ -25,6 +25,11 @@ const float kCosBend = std::cos(25.0f * kPi / 180.0f);
 // points is scaled by this, so that it fills the hollow without bulging out of the body where the
 // stitch is concave. docs/proxies.md, "Shoulder fills", has the sweep it was chosen from.
 constexpr float kShoulderFillScale = 0.75f;
+// Hip fills (ProxyBuilder::hipFill): the box's cross-section (forward, sideways) is scaled by this,
+// its length (from the thigh ring up to the hip ring) is kept whole. Scaled 1.0 across, the fills
+// bulged out of the hips of the Kinect bodies and the skirt's and dress's worst frames sank deeper
+// there; 0.75 leaves the Kinect takes as they were (docs/proxies.md, "Hip fills").
+constexpr float kHipFillSection = 0.75f;
 
 float ringSpacing(const BodyModel& body, int first, int count, int i) {
   const auto& rings = body.rings();
@@ -113,6 +118,71 @@ Ellipsoid ProxyBuilder::shoulderFill(const BodyModel& body, const ShoulderStitch
   return e;
 }
 
+void ProxyBuilder::planHipFills(const BodyModel& body) {
+  const int K = body.ringPoints();
+  const int hip = body.chainFirstRing(Chain::Torso);
+  const auto& rings = body.rings();
+  const RingPose& h = rings[static_cast<size_t>(hip)];
+  for (int side = 0; side < 2; ++side) {
+    HipStitch& s = hips_[side];
+    s.thigh_ring = body.chainFirstRing(side == 1 ? Chain::LegL : Chain::LegR);
+    // The hip ring's half on this thigh's side: the sign of its points' sideways coordinate (the
+    // ring frame's z, ringPointAt) is the thigh's. The frame follows the body, so the half found on
+    // the first build's pose is the same on every pose.
+    const float side_sign =
+        (rings[static_cast<size_t>(s.thigh_ring)].centre - h.centre).dot(h.frame.col(2)) < 0.0f ? -1.0f : 1.0f;
+    s.hip.clear();
+    s.thigh.clear();
+    for (int j = 0; j < K; ++j) {
+      const float theta = 2.0f * kPi * static_cast<float>(j) / static_cast<float>(K);
+      const StitchPoint p{hip, std::cos(theta), std::sin(theta)};
+      if (p.s * side_sign > 1e-4f) s.hip.push_back(p);
+      s.thigh.push_back({s.thigh_ring, p.c, p.s});
+    }
+  }
+}
+
+// The crotch stitch between the hip ring (the torso's first) and the thighs' first rings is, on
+// each side, a band of triangles that the ring ellipsoids cover only near its ends: the thigh ring
+// hangs below the hip joint by the crotch drop, and how far the hip joints sit below the pelvis
+// depends on the skeleton (5 cm on the Kinect takes, 16 cm on the CMU takes, whose hip joints
+// are the femur heads). Cloth over the hips sank up to 5 cm into the body mesh there. The fill
+// spans the band: the box of the hip ring's half on that side and of the thigh ring, in a frame
+// with y from the thigh ring's centre to the half's centroid and x the hip ring's forward; its
+// cross-section scaled by kHipFillSection, its length whole (docs/proxies.md, "Hip fills").
+Ellipsoid ProxyBuilder::hipFill(const BodyModel& body, const HipStitch& s) const {
+  const auto& rings = body.rings();
+  const auto point = [&](const StitchPoint& p) { return ringPointAt(rings[static_cast<size_t>(p.ring)], p.c, p.s); };
+  const RingPose& thigh = rings[static_cast<size_t>(s.thigh_ring)];
+  const RingPose& hip = rings[static_cast<size_t>(body.chainFirstRing(Chain::Torso))];
+  Vec3 c = Vec3::Zero();
+  for (const StitchPoint& p : s.hip) c += point(p);
+  c /= static_cast<float>(std::max<size_t>(s.hip.size(), 1));
+  Vec3 y = c - thigh.centre;
+  y = y.norm() > 1e-6f ? Vec3(y.normalized()) : Vec3(thigh.frame.col(1));
+  Vec3 x = hip.frame.col(0) - hip.frame.col(0).dot(y) * y;
+  if (x.norm() < 1e-6f) x = hip.frame.col(2) - hip.frame.col(2).dot(y) * y;
+  x.normalize();
+  Mat3 R;
+  R.col(0) = x;
+  R.col(1) = y;
+  R.col(2) = x.cross(y);
+  Vec3 lo = Vec3::Constant(std::numeric_limits<float>::infinity()), hi = -lo;
+  for (const std::vector<StitchPoint>* part : {&s.hip, &s.thigh}) {
+    for (const StitchPoint& p : *part) {
+      const Vec3 q = R.transpose() * (point(p) - c);
+      lo = lo.cwiseMin(q);
+      hi = hi.cwiseMax(q);
+    }
+  }
+  if (!(lo.array() <= hi.array()).all()) lo = hi = Vec3::Zero();  // no points (not for a valid body)
+  Ellipsoid e;
+  e.centre = c + R * (0.5f * (lo + hi));
+  e.rotation = R;
+  e.radii = (0.5f * (hi - lo)).cwiseProduct(Vec3(kHipFillSection, 1.0f, kHipFillSection)).cwiseMax(Vec3::Constant(1e-3f));
+  return e;
+}
+
 void ProxyBuilder::planSubRings(const BodyModel& body) {
   // Decided once, on the rings as first built, so the ellipsoid count never changes.
   const auto& rings = body.rings();
@@ -178,6 +248,7 @@ void ProxyBuilder::buildAll(const BodyModel& body, const SkeletonPose& pose) {
   built_ = 0;
   if (subRings_.empty()) planSubRings(body);
   if (shoulders_[0].junction.empty()) planShoulderFills(body);
+  if (hips_[0].thigh.empty()) planHipFills(body);
   const auto& rings = body.rings();
   const bool paper = rule_ == ProxyRule::Paper;
 
@@ -314,6 +385,15 @@ void ProxyBuilder::buildAll(const BodyModel& body, const SkeletonPose& pose) {
                             static_cast<int>(Chain::Torso)};
       if (skipNext(src)) continue;
       add(shoulderFill(body, s), src);
+    }
+    // Hip fills (hipFill above), right then left. Only the cloth of their own leg, and the torso's
+    // on that side (GarmentSim::maskFor), meets them: the other trouser leg would be caught
+    // between the two.
+    for (int side = 0; side < 2; ++side) {
+      const HipStitch& s = hips_[side];
+      const ProxySource src{side == 1 ? Chain::LegL : Chain::LegR, s.thigh_ring, -1, -1};
+      if (skipNext(src)) continue;
+      add(hipFill(body, s), src);
     }
   }
   // ellipsoids_ never shrinks (no allocation per frame); the live count is count_.

@@ -9,8 +9,8 @@
 //    further apart than the local radius; long semi-axis = kOverlap x the larger neighbour
 //    spacing and cross-section scaled so the union neither dips between rings nor bulges at them
 //    by more than ~3 %; chain ends and bends reach only to their neighbour; after the ring
-//    ellipsoids, a slim cap per chain end and a fill per shoulder (docs/proxies.md has the
-//    derivation and the measured before/after).
+//    ellipsoids, a slim cap per chain end, a fill per shoulder and one per hip (docs/proxies.md
+//    has the derivation and the measured before/after).
 #pragma once
 
 #include "body/body_model.h"
@@ -36,6 +36,11 @@ struct ProxySource {
 // The collision groups of an ellipsoid (bit 1 << chain per chain it belongs to): what cloth
 // collision groups (GarmentSim) and the garments' reach (cloth/garment_reach.h) test against.
 uint8_t collisionGroups(const ProxySource& source);
+// Two group bits above the chains' (GarmentSim::maskFor, setLegsTrusted): the torso cloth of a
+// template garment over the left / right leg. A leg's ellipsoids carry them while the leg is
+// trusted; collisionGroups() never sets them.
+inline constexpr uint8_t kTorsoOverLegL = 1u << 6, kTorsoOverLegR = 1u << 7;
+static_assert(kChainCount <= 6, "the chain bits must stay below kTorsoOverLegL");
 
 class ProxyBuilder {
  public:
@@ -83,6 +88,15 @@ class ProxyBuilder {
   void planShoulderFills(const BodyModel& body);
   Ellipsoid shoulderFill(const BodyModel& body, const ShoulderStitch& stitch) const;
   ShoulderStitch shoulders_[2];  // right, left; empty until the first build
+  // Hip fills (Drape rule): per thigh, the hip ring's points on its side and the thigh ring's
+  // points, found once like the shoulders'.
+  struct HipStitch {
+    std::vector<StitchPoint> hip, thigh;
+    int thigh_ring = 0;
+  };
+  void planHipFills(const BodyModel& body);
+  Ellipsoid hipFill(const BodyModel& body, const HipStitch& stitch) const;
+  HipStitch hips_[2];  // right, left; empty until the first build
   std::vector<int> subRings_;        // per ring: sub-rings inserted before the next ring
   std::vector<RingPose> scratch_;    // one chain's rings and sub-rings
   std::vector<int> scratchRing_;     // the ring each of them belongs to
