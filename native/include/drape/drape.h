@@ -298,9 +298,12 @@ DRAPE_API drape_result DRAPE_CALL drape_context_read_body_mesh(drape_context* co
 
 /* One tracking ellipsoid: world point p is inside when |diag(1/radii) * [axis_x axis_y axis_z]^T
  * (p - centre)| < 1. Axes are unit and orthogonal (a rotation); axis_y runs along the bone. With
- * the Drape rule the last two are the shoulder fills (right, then left; docs/proxies.md): chain =
- * the arm, ring = its junction ring, axis_y from the base of the neck to the shoulder joint; cloth
- * of the torso collides with them too. */
+ * the Drape rule the last four are fills (docs/proxies.md). First the shoulder fills (right, then
+ * left): chain = the arm, ring = its junction ring, axis_y from the base of the neck to the
+ * shoulder joint; cloth of the torso collides with them too. Then the hip fills (right, then
+ * left): chain = the leg, ring = its first (thigh) ring, axis_y from the thigh ring up to the hip
+ * ring's side; cloth of that leg collides with them, and a template garment's torso cloth on that
+ * side while the leg's hip and knee are tracked. */
 typedef struct drape_ellipsoid {
   drape_vec3 centre;
   drape_vec3 axis_x;  /* body forward (limbs: carried along the limb without twist) */

@@ -191,6 +191,7 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
   g->masks_.resize(g->mesh_.positions.size());
   for (size_t i = 0; i < g->masks_.size(); ++i)
     g->masks_[i] = maskFor(body_rest, g->mesh_.positions[i], torso_meets_legs);
+  g->torso_meets_legs_ = torso_meets_legs;
   g->setLegsTrusted(true, true);  // the rest body's legs, where the garment is dressed outside them
   g->kind_ = solver;
   g->solver_ = makeSolver(solver, g->topology_);
@@ -407,7 +408,7 @@ bool GarmentSim::torsoClothInside(const Ellipsoid& e, uint8_t over) const {
 }
 
 void GarmentSim::updateLegClearance(const std::vector<Ellipsoid>& ellipsoids, uint8_t recheck_sides) {
-  if (unclear_legs_ == 0 && recheck_sides == 0) return;
+  if (!torso_meets_legs_ || (unclear_legs_ == 0 && recheck_sides == 0)) return;
   const uint8_t legL = static_cast<uint8_t>(1u << static_cast<int>(Chain::LegL));
   const uint8_t legR = static_cast<uint8_t>(1u << static_cast<int>(Chain::LegR));
   if (leg_clear_.size() != base_groups_.size()) leg_clear_.assign(base_groups_.size(), 1);

@@ -198,12 +198,12 @@ class GarmentSim {
   static uint8_t maskForChain(int chain);
   // Torso cloth of a template garment (create's torso_meets_legs) also collides with the leg on
   // its side, through the group bits kTorsoOverLegL / R (proxies/proxy_builder.h), which a leg's
-  // ellipsoids carry only while that leg is trusted (setLegsTrusted). Why: a shirt's hem hangs over the tops of
-  // the thighs, and when the hip bent (the CMU hop takes) the thighs rose through it, the deepest
-  // body penetration of the shared takes (docs/garments.md, "Torso cloth on the thighs"). Why
-  // not always: a leg the sensor only infers (a person close to a Kinect, legs out of view) is
-  // guessed, and pushed through the shirt it tore it; and an OBJ garment's torso cloth may be a
-  // suit's seat, which on a heavy body tore between the hip and thigh ellipsoids.
+  // ellipsoids carry only while that leg is trusted (setLegsTrusted) and clear of torso cloth
+  // (updateLegClearance). Why: a shirt's hem hangs over the tops of the thighs, and when the hip
+  // bent (the CMU hop takes) the thighs rose through it, the deepest body penetration of the
+  // shared takes (docs/garments.md, "Torso cloth over the thighs"). Why not always: a leg the
+  // sensor only infers is a guess; and an OBJ garment's torso cloth may be a suit's seat, which on
+  // a heavy body tore between the hip and thigh ellipsoids.
   static uint8_t maskFor(const BodyModel& body, const Vec3& p, bool torso_meets_legs);
   // Whether each leg's ellipsoids are trusted this frame (Context: hip and knee Tracked); while
   // one is not, torso cloth passes through it as before. Cheap when nothing changed.
@@ -337,6 +337,7 @@ class GarmentSim {
   // ellipsoid is clear: it held no torso cloth when the garment was last placed on the body (first
   // frame, pose jump) or when the leg was last trusted again, or none since (leg_clear_, one entry
   // per ellipsoid; empty: all clear). Pushed out at once, cloth a leg had passed into tore.
+  bool torso_meets_legs_ = false;  // create's flag: a template's torso cloth has kTorsoOverLeg bits
   bool host_legs_[2] = {true, true};
   uint8_t recheck_legs_ = 0;  // bit per side: trusted again since the last step
   std::vector<uint8_t> leg_clear_;

@@ -121,16 +121,13 @@ Ellipsoid ProxyBuilder::shoulderFill(const BodyModel& body, const ShoulderStitch
 void ProxyBuilder::planHipFills(const BodyModel& body) {
   const int K = body.ringPoints();
   const int hip = body.chainFirstRing(Chain::Torso);
-  const auto& rings = body.rings();
-  const RingPose& h = rings[static_cast<size_t>(hip)];
   for (int side = 0; side < 2; ++side) {
     HipStitch& s = hips_[side];
     s.thigh_ring = body.chainFirstRing(side == 1 ? Chain::LegL : Chain::LegR);
-    // The hip ring's half on this thigh's side: the sign of its points' sideways coordinate (the
-    // ring frame's z, ringPointAt) is the thigh's. The frame follows the body, so the half found on
-    // the first build's pose is the same on every pose.
-    const float side_sign =
-        (rings[static_cast<size_t>(s.thigh_ring)].centre - h.centre).dot(h.frame.col(2)) < 0.0f ? -1.0f : 1.0f;
+    // The hip ring's half on this thigh's side: its points whose sideways coordinate (the ring
+    // frame's z, ringPointAt) has the thigh's sign. A torso ring's z is the body's right (hip to
+    // hip, BodyModel::placeRings), whatever the pose.
+    const float side_sign = side == 1 ? -1.0f : 1.0f;
     s.hip.clear();
     s.thigh.clear();
     for (int j = 0; j < K; ++j) {
