@@ -152,7 +152,34 @@ float shoulderTopGapMm(const BodyModel& body, const std::vector<Ellipsoid>& e, s
   return 1000.0f * worst;
 }
 
-// The shoulder fills (the last two Drape-rule ellipsoids) cover the top of the shoulders, which
+// Tracks every frame of the take; on every 10th, updates its body, builds `proxies` on it and calls
+// `measure`.
+template <class Measure>
+void everyTenthFrame(TrackedTake& take, ProxyBuilder& proxies, Measure measure) {
+  for (size_t i = 0; i < take.rec.frames.size(); ++i) {
+    ASSERT_TRUE(take.track(i)) << take.err;
+    if (i % 10 != 0) continue;
+    take.body.update(take.tracker.pose());
+    proxies.build(take.body, take.tracker.pose());
+    measure();
+  }
+}
+
+// The pair of fills `from_end` ellipsoids before the end of `sources` (right side first): built
+// from their chain's first ring, in that chain's group plus `extra_groups`.
+void expectFillPair(const std::vector<ProxySource>& sources, const BodyModel& body, size_t from_end, Chain right,
+                    Chain left, uint8_t extra_groups) {
+  ASSERT_GE(sources.size(), from_end);
+  for (int side = 0; side < 2; ++side) {
+    const ProxySource& s = sources[sources.size() - from_end + static_cast<size_t>(side)];
+    const Chain chain = side == 1 ? left : right;
+    EXPECT_EQ(s.chain, chain);
+    EXPECT_EQ(s.first_ring, body.chainFirstRing(chain));
+    EXPECT_EQ(collisionGroups(s), (1u << static_cast<int>(chain)) | extra_groups);
+  }
+}
+
+// The shoulder fills (the Drape rule's two before the hip fills) cover the top of the shoulders, which
 // the ring ellipsoids leave open: cloth lying on them sank up to 2 cm into the body mesh there.
 TEST_P(ProxiesOnRecording, ShoulderFillsCoverTheTopsOfTheShoulders) {
   DRAPE_REQUIRE_SHARED(path, GetParam().file);
@@ -161,26 +188,14 @@ TEST_P(ProxiesOnRecording, ShoulderFillsCoverTheTopsOfTheShoulders) {
   BodyModel& body = take.body;
   ProxyBuilder ours(ProxyRule::Drape);
   ours.build(body, restPose(take.shape));
-  const auto& src = ours.sources();
-  ASSERT_GE(src.size(), 4u);
   // The last four: the shoulder fills (right, left), then the hip fills.
-  for (int side = 0; side < 2; ++side) {
-    const ProxySource& s = src[src.size() - 4 + static_cast<size_t>(side)];
-    const Chain arm = side == 1 ? Chain::ArmL : Chain::ArmR;
-    EXPECT_EQ(s.chain, arm);
-    EXPECT_EQ(s.first_ring, body.chainFirstRing(arm));
-    EXPECT_EQ(collisionGroups(s), (1u << static_cast<int>(arm)) | (1u << static_cast<int>(Chain::Torso)));
-  }
+  expectFillPair(ours.sources(), body, 4, Chain::ArmR, Chain::ArmL, 1u << static_cast<int>(Chain::Torso));
   float with = 0.0f, without = 0.0f;
-  for (size_t i = 0; i < take.rec.frames.size(); ++i) {
-    ASSERT_TRUE(take.track(i)) << take.err;
-    if (i % 10 != 0) continue;
-    body.update(take.tracker.pose());
-    ours.build(body, take.tracker.pose());
+  everyTenthFrame(take, ours, [&] {
     const auto& e = ours.ellipsoids();
     with = std::max(with, shoulderTopGapMm(body, e, e.size() - 2));
     without = std::max(without, shoulderTopGapMm(body, e, e.size() - 4));
-  }
+  });
   std::printf("  %s: top of the shoulders outside the ellipsoids by up to %.1f mm, %.1f mm without the fills\n",
               GetParam().file, with, without);
   EXPECT_LT(with, 0.5f * without);
@@ -228,25 +243,13 @@ TEST_P(ProxiesOnRecording, HipFillsSpanTheHipStitch) {
   BodyModel& body = take.body;
   ProxyBuilder ours(ProxyRule::Drape);
   ours.build(body, restPose(take.shape));
-  const auto& src = ours.sources();
-  ASSERT_GE(src.size(), 2u);
-  for (int side = 0; side < 2; ++side) {
-    const ProxySource& s = src[src.size() - 2 + static_cast<size_t>(side)];
-    const Chain leg = side == 1 ? Chain::LegL : Chain::LegR;
-    EXPECT_EQ(s.chain, leg);
-    EXPECT_EQ(s.first_ring, body.chainFirstRing(leg));
-    EXPECT_EQ(collisionGroups(s), 1u << static_cast<int>(leg));  // the other trouser leg passes it
-  }
+  expectFillPair(ours.sources(), body, 2, Chain::LegR, Chain::LegL, 0);  // the other trouser leg passes it
   std::vector<float> with, without;
-  for (size_t i = 0; i < take.rec.frames.size(); ++i) {
-    ASSERT_TRUE(take.track(i)) << take.err;
-    if (i % 10 != 0) continue;
-    body.update(take.tracker.pose());
-    ours.build(body, take.tracker.pose());
+  everyTenthFrame(take, ours, [&] {
     const auto& e = ours.ellipsoids();
     hipStitchGapsMm(body, e, e.size(), with);
     hipStitchGapsMm(body, e, e.size() - 2, without);
-  }
+  });
   auto stats = [](std::vector<float> v) {
     std::sort(v.begin(), v.end());
     double sum = 0.0;

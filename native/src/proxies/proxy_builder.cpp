@@ -85,25 +85,37 @@ void ProxyBuilder::planShoulderFills(const BodyModel& body) {
 // fills").
 Ellipsoid ProxyBuilder::shoulderFill(const BodyModel& body, const ShoulderStitch& s) const {
   const auto& rings = body.rings();
-  // From the rings, not the mesh, which may not be updated this frame (capi/adaptive.h).
-  const auto point = [&](const StitchPoint& p) { return ringPointAt(rings[static_cast<size_t>(p.ring)], p.c, p.s); };
   const RingPose& junction = rings[static_cast<size_t>(s.junction_ring)];
   const RingPose& top = rings[static_cast<size_t>(body.chainFirstRing(Chain::Torso) +
                                                   body.chainRingCount(Chain::Torso) - 1)];
-  Vec3 c = Vec3::Zero();
-  for (const StitchPoint& p : s.neck) c += point(p);
-  c /= static_cast<float>(std::max<size_t>(s.neck.size(), 1));
+  const Vec3 c = centroid(body, s.neck);
   Vec3 y = junction.centre - c;
   y = y.norm() > 1e-6f ? Vec3(y.normalized()) : Vec3(junction.frame.col(1));
-  Vec3 x = top.frame.col(0) - top.frame.col(0).dot(y) * y;
-  if (x.norm() < 1e-6f) x = top.frame.col(2) - top.frame.col(2).dot(y) * y;
+  return fillInBox(body, c, y, top.frame, s.neck, s.junction, Vec3::Constant(kShoulderFillScale));
+}
+
+Vec3 ProxyBuilder::centroid(const BodyModel& body, const std::vector<StitchPoint>& points) {
+  // From the rings, not the mesh, which may not be updated this frame (capi/adaptive.h).
+  const auto& rings = body.rings();
+  Vec3 c = Vec3::Zero();
+  for (const StitchPoint& p : points) c += ringPointAt(rings[static_cast<size_t>(p.ring)], p.c, p.s);
+  return c / static_cast<float>(std::max<size_t>(points.size(), 1));
+}
+
+Ellipsoid ProxyBuilder::fillInBox(const BodyModel& body, const Vec3& c, const Vec3& y, const Mat3& frame,
+                                  const std::vector<StitchPoint>& a, const std::vector<StitchPoint>& b,
+                                  const Vec3& scale) {
+  const auto& rings = body.rings();
+  const auto point = [&](const StitchPoint& p) { return ringPointAt(rings[static_cast<size_t>(p.ring)], p.c, p.s); };
+  Vec3 x = frame.col(0) - frame.col(0).dot(y) * y;
+  if (x.norm() < 1e-6f) x = frame.col(2) - frame.col(2).dot(y) * y;
   x.normalize();
   Mat3 R;
   R.col(0) = x;
   R.col(1) = y;
   R.col(2) = x.cross(y);
   Vec3 lo = Vec3::Constant(std::numeric_limits<float>::infinity()), hi = -lo;
-  for (const std::vector<StitchPoint>* part : {&s.neck, &s.junction}) {
+  for (const std::vector<StitchPoint>* part : {&a, &b}) {
     for (const StitchPoint& p : *part) {
       const Vec3 q = R.transpose() * (point(p) - c);
       lo = lo.cwiseMin(q);
@@ -114,7 +126,7 @@ Ellipsoid ProxyBuilder::shoulderFill(const BodyModel& body, const ShoulderStitch
   Ellipsoid e;
   e.centre = c + R * (0.5f * (lo + hi));
   e.rotation = R;
-  e.radii = (kShoulderFillScale * 0.5f * (hi - lo)).cwiseMax(Vec3::Constant(1e-3f));
+  e.radii = (0.5f * (hi - lo)).cwiseProduct(scale).cwiseMax(Vec3::Constant(1e-3f));
   return e;
 }
 
@@ -149,35 +161,12 @@ void ProxyBuilder::planHipFills(const BodyModel& body) {
 // cross-section scaled by kHipFillSection, its length whole (docs/proxies.md, "Hip fills").
 Ellipsoid ProxyBuilder::hipFill(const BodyModel& body, const HipStitch& s) const {
   const auto& rings = body.rings();
-  const auto point = [&](const StitchPoint& p) { return ringPointAt(rings[static_cast<size_t>(p.ring)], p.c, p.s); };
   const RingPose& thigh = rings[static_cast<size_t>(s.thigh_ring)];
   const RingPose& hip = rings[static_cast<size_t>(body.chainFirstRing(Chain::Torso))];
-  Vec3 c = Vec3::Zero();
-  for (const StitchPoint& p : s.hip) c += point(p);
-  c /= static_cast<float>(std::max<size_t>(s.hip.size(), 1));
+  const Vec3 c = centroid(body, s.hip);
   Vec3 y = c - thigh.centre;
   y = y.norm() > 1e-6f ? Vec3(y.normalized()) : Vec3(thigh.frame.col(1));
-  Vec3 x = hip.frame.col(0) - hip.frame.col(0).dot(y) * y;
-  if (x.norm() < 1e-6f) x = hip.frame.col(2) - hip.frame.col(2).dot(y) * y;
-  x.normalize();
-  Mat3 R;
-  R.col(0) = x;
-  R.col(1) = y;
-  R.col(2) = x.cross(y);
-  Vec3 lo = Vec3::Constant(std::numeric_limits<float>::infinity()), hi = -lo;
-  for (const std::vector<StitchPoint>* part : {&s.hip, &s.thigh}) {
-    for (const StitchPoint& p : *part) {
-      const Vec3 q = R.transpose() * (point(p) - c);
-      lo = lo.cwiseMin(q);
-      hi = hi.cwiseMax(q);
-    }
-  }
-  if (!(lo.array() <= hi.array()).all()) lo = hi = Vec3::Zero();  // no points (not for a valid body)
-  Ellipsoid e;
-  e.centre = c + R * (0.5f * (lo + hi));
-  e.rotation = R;
-  e.radii = (0.5f * (hi - lo)).cwiseProduct(Vec3(kHipFillSection, 1.0f, kHipFillSection)).cwiseMax(Vec3::Constant(1e-3f));
-  return e;
+  return fillInBox(body, c, y, hip.frame, s.hip, s.thigh, Vec3(kHipFillSection, 1.0f, kHipFillSection));
 }
 
 void ProxyBuilder::planSubRings(const BodyModel& body) {

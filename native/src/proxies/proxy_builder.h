@@ -85,6 +85,14 @@ class ProxyBuilder {
     std::vector<StitchPoint> neck, junction;
     int junction_ring = 0;
   };
+  // The centroid of `points` (from the rings, ringPointAt).
+  static Vec3 centroid(const BodyModel& body, const std::vector<StitchPoint>& points);
+  // A fill: the ellipsoid inscribed in the box of the points of `a` and `b` in the frame with y
+  // (unit) given and x the part of frame's x orthogonal to it (else of its z), measured from c;
+  // its semi-axes scaled per axis by `scale`.
+  static Ellipsoid fillInBox(const BodyModel& body, const Vec3& c, const Vec3& y, const Mat3& frame,
+                             const std::vector<StitchPoint>& a, const std::vector<StitchPoint>& b,
+                             const Vec3& scale);
   void planShoulderFills(const BodyModel& body);
   Ellipsoid shoulderFill(const BodyModel& body, const ShoulderStitch& stitch) const;
   ShoulderStitch shoulders_[2];  // right, left; empty until the first build
