@@ -64,6 +64,14 @@ inline GarmentSim* addTemplate(Context& ctx, GarmentKind kind, int particles, Cl
   return g ? ctx.adoptGarment(std::move(g)) : nullptr;
 }
 
+// Reads the recording at `path` into `rec` and adds a template T-shirt of `particles` to `ctx`;
+// null and err when either fails.
+inline GarmentSim* readTakeAndAddTShirt(Context& ctx, const std::string& path, int particles, Recording& rec,
+                                        std::string& err) {
+  if (!readRecordingFile(path, 0, rec, err)) return nullptr;
+  return addTemplate(ctx, GarmentKind::TShirt, particles, ClothSolverKind::Xpbd, GarmentSimParams{}, err);
+}
+
 // Pushes frame `f` of `rec` (optionally changed by `perturb`) and steps by `dt`.
 inline drape_result pushAndStep(Context& ctx, const Recording& rec, const RecordingFrame& f,
                                 double time_s, float dt, std::string& err) {

@@ -14,9 +14,8 @@
 namespace drape {
 namespace {
 
-constexpr uint8_t chainBit(Chain c) { return static_cast<uint8_t>(1u << static_cast<int>(c)); }
-constexpr uint8_t kLegBits = chainBit(Chain::LegL) | chainBit(Chain::LegR);
-constexpr uint8_t kArmBits = chainBit(Chain::ArmL) | chainBit(Chain::ArmR);
+constexpr uint8_t kLegBits = chainGroup(Chain::LegL) | chainGroup(Chain::LegR);
+constexpr uint8_t kArmBits = chainGroup(Chain::ArmL) | chainGroup(Chain::ArmR);
 constexpr uint8_t kOverBits = kTorsoOverLegL | kTorsoOverLegR;
 
 // A T-shirt's torso cloth meets the leg on its side (the nearer thigh ring), never both; its
@@ -38,7 +37,7 @@ TEST(GarmentLegGroups, TemplateTorsoClothMeetsTheLegOnItsSide) {
     for (size_t i = 0; i < masks.size(); ++i) {
       const uint8_t m = masks[i];
       EXPECT_EQ(GarmentSim::maskFor(body, rest[i], false) & kOverBits, 0) << "particle " << i;
-      const bool torso = (m & chainBit(Chain::Torso)) && !(m & (kLegBits | kArmBits));
+      const bool torso = (m & chainGroup(Chain::Torso)) && !(m & (kLegBits | kArmBits));
       if (!torso) {
         EXPECT_EQ(m & kOverBits, 0) << "sleeve or trouser-leg particle " << i;
         continue;
@@ -70,11 +69,11 @@ TEST(GarmentLegGroups, UntrustedLegIsPassedThrough) {
     size_t legs = 0;
     for (size_t k = 0; k < base.size(); ++k) {
       EXPECT_EQ(now[k] & ~kOverBits, base[k]) << "ellipsoid " << k;
-      if (base[k] & chainBit(Chain::LegL)) {
+      if (base[k] & chainGroup(Chain::LegL)) {
         EXPECT_EQ((now[k] & kTorsoOverLegL) != 0, left) << "ellipsoid " << k;
         ++legs;
       }
-      if (base[k] & chainBit(Chain::LegR)) {
+      if (base[k] & chainGroup(Chain::LegR)) {
         EXPECT_EQ((now[k] & kTorsoOverLegR) != 0, !left) << "ellipsoid " << k;
         ++legs;
       }
@@ -84,8 +83,8 @@ TEST(GarmentLegGroups, UntrustedLegIsPassedThrough) {
   }
   g->setLegsTrusted(true, true);
   for (size_t k = 0; k < base.size(); ++k) {
-    if (base[k] & chainBit(Chain::LegL)) EXPECT_NE(g->ellipsoidGroups()[k] & kTorsoOverLegL, 0);
-    if (base[k] & chainBit(Chain::LegR)) EXPECT_NE(g->ellipsoidGroups()[k] & kTorsoOverLegR, 0);
+    if (base[k] & chainGroup(Chain::LegL)) EXPECT_NE(g->ellipsoidGroups()[k] & kTorsoOverLegL, 0);
+    if (base[k] & chainGroup(Chain::LegR)) EXPECT_NE(g->ellipsoidGroups()[k] & kTorsoOverLegR, 0);
   }
 }
 
@@ -99,9 +98,8 @@ TEST(GarmentLegGroups, ThighsPlacedThroughTheHemWaitUntilItIsOut) {
   DRAPE_REQUIRE_SHARED(path, "kinect_v2_msft_labanotation/KinectReader_joints_closerange.csv");
   Recording rec;
   std::string err;
-  ASSERT_TRUE(readRecordingFile(path, 0, rec, err)) << err;
   Context ctx(test::defaultDesc());
-  GarmentSim* g = test::addTemplate(ctx, GarmentKind::TShirt, 1000, ClothSolverKind::Xpbd, GarmentSimParams{}, err);
+  GarmentSim* g = test::readTakeAndAddTShirt(ctx, path, 1000, rec, err);
   ASSERT_NE(g, nullptr) << err;
   const std::vector<uint8_t>& base = ctx.restEllipsoidGroups();
   size_t mostWaiting = 0;
@@ -116,13 +114,13 @@ TEST(GarmentLegGroups, ThighsPlacedThroughTheHemWaitUntilItIsOut) {
     // A side is trusted this step when any of its leg's ellipsoids meets the torso cloth.
     bool trusted[2] = {false, false};
     for (size_t k = 0; k < base.size(); ++k) {
-      if (base[k] & chainBit(Chain::LegL) && now[k] & kTorsoOverLegL) trusted[0] = true;
-      if (base[k] & chainBit(Chain::LegR) && now[k] & kTorsoOverLegR) trusted[1] = true;
+      if (base[k] & chainGroup(Chain::LegL) && now[k] & kTorsoOverLegL) trusted[0] = true;
+      if (base[k] & chainGroup(Chain::LegR) && now[k] & kTorsoOverLegR) trusted[1] = true;
     }
     size_t waiting = 0;
     for (size_t k = 0; k < base.size() && k < e.size(); ++k) {
       if (!(base[k] & kLegBits)) continue;
-      const int side = (base[k] & chainBit(Chain::LegL)) ? 0 : 1;
+      const int side = (base[k] & chainGroup(Chain::LegL)) ? 0 : 1;
       const uint8_t over = side == 0 ? kTorsoOverLegL : kTorsoOverLegR;
       if (!(now[k] & over)) {
         waiting += trusted[side];

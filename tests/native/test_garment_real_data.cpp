@@ -46,9 +46,8 @@ TEST_P(GarmentOnRecording, TShirtStaysFiniteOutsideAndBounded) {
   DRAPE_REQUIRE_SHARED(path, GetParam().file);
   Recording rec;
   std::string err;
-  ASSERT_TRUE(readRecordingFile(path, 0, rec, err)) << err;
   Context ctx(test::defaultDesc());
-  GarmentSim* g = test::addTemplate(ctx, GarmentKind::TShirt, 1000, ClothSolverKind::Xpbd, GarmentSimParams{}, err);
+  GarmentSim* g = test::readTakeAndAddTShirt(ctx, path, 1000, rec, err);
   ASSERT_NE(g, nullptr) << err;
   const test::SceneSummary s = test::replay(ctx, *g, rec, err, /*measure_body=*/false);
   std::printf("[ figures  ] %s: %d frames, P99 stretch median %.3f worst %.3f, max %.3f, inside %llu, vmax %.2f m/s, "

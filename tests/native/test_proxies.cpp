@@ -64,6 +64,12 @@ struct TrackedTake {
   SkeletonTracker tracker;
   std::string err;
   bool open(const std::string& path) { return readRecordingFile(path, 0, rec, err); }
+  // Opens the take and builds `proxies` on its body in the rest pose.
+  bool openAtRest(const std::string& path, ProxyBuilder& proxies) {
+    if (!open(path)) return false;
+    proxies.build(body, restPose(shape));
+    return true;
+  }
   // Pushes frame i into the tracker (the body is the caller's to update); false and err when the
   // frame does not map to the canonical skeleton.
   bool track(size_t i) {
@@ -184,10 +190,9 @@ void expectFillPair(const std::vector<ProxySource>& sources, const BodyModel& bo
 TEST_P(ProxiesOnRecording, ShoulderFillsCoverTheTopsOfTheShoulders) {
   DRAPE_REQUIRE_SHARED(path, GetParam().file);
   TrackedTake take;
-  ASSERT_TRUE(take.open(path)) << take.err;
-  BodyModel& body = take.body;
   ProxyBuilder ours(ProxyRule::Drape);
-  ours.build(body, restPose(take.shape));
+  ASSERT_TRUE(take.openAtRest(path, ours)) << take.err;
+  BodyModel& body = take.body;
   // The last four: the shoulder fills (right, left), then the hip fills.
   expectFillPair(ours.sources(), body, 4, Chain::ArmR, Chain::ArmL, 1u << static_cast<int>(Chain::Torso));
   float with = 0.0f, without = 0.0f;
@@ -239,10 +244,9 @@ void hipStitchGapsMm(const BodyModel& body, const std::vector<Ellipsoid>& e, siz
 TEST_P(ProxiesOnRecording, HipFillsSpanTheHipStitch) {
   DRAPE_REQUIRE_SHARED(path, GetParam().file);
   TrackedTake take;
-  ASSERT_TRUE(take.open(path)) << take.err;
-  BodyModel& body = take.body;
   ProxyBuilder ours(ProxyRule::Drape);
-  ours.build(body, restPose(take.shape));
+  ASSERT_TRUE(take.openAtRest(path, ours)) << take.err;
+  BodyModel& body = take.body;
   expectFillPair(ours.sources(), body, 2, Chain::LegR, Chain::LegL, 0);  // the other trouser leg passes it
   std::vector<float> with, without;
   everyTenthFrame(take, ours, [&] {

@@ -104,8 +104,8 @@ void markReachable(const std::vector<ReachSphere>& spheres, const std::vector<Ri
     uint8_t bits = collisionGroups(sources[k]);
     // A leg's ellipsoids may meet torso cloth over that leg (GarmentSim::setLegsTrusted): reach
     // counts them as if trusted, so a leg trusted again finds them built.
-    if (bits & (1u << static_cast<int>(Chain::LegL))) bits = static_cast<uint8_t>(bits | kTorsoOverLegL);
-    if (bits & (1u << static_cast<int>(Chain::LegR))) bits = static_cast<uint8_t>(bits | kTorsoOverLegR);
+    if (bits & chainGroup(Chain::LegL)) bits = static_cast<uint8_t>(bits | kTorsoOverLegL);
+    if (bits & chainGroup(Chain::LegR)) bits = static_cast<uint8_t>(bits | kTorsoOverLegR);
     const int r = std::clamp(sources[k].first_ring, 0, ringCount - 1);
     const Vec3& c = rings[static_cast<size_t>(r)].centre;
     const float bound = k < bound_radii.size() ? bound_radii[k] : std::numeric_limits<float>::infinity();

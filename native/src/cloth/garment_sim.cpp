@@ -192,7 +192,7 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
   for (size_t i = 0; i < g->masks_.size(); ++i)
     g->masks_[i] = maskFor(body_rest, g->mesh_.positions[i], torso_meets_legs);
   g->torso_meets_legs_ = torso_meets_legs;
-  g->setLegsTrusted(true, true);  // the rest body's legs, where the garment is dressed outside them
+  g->applyLegGroups();  // legs trusted (the rest body's, where the garment is dressed outside them)
   g->kind_ = solver;
   g->solver_ = makeSolver(solver, g->topology_);
   if (!g->setParams(params, err)) return nullptr;
@@ -367,6 +367,7 @@ uint8_t GarmentSim::maskFor(const BodyModel& body, const Vec3& p, bool torso_mee
 }
 
 void GarmentSim::setLegsTrusted(bool left, bool right) {
+  if (left == host_legs_[0] && right == host_legs_[1]) return;  // the usual frame: nothing changed
   const bool now[2] = {left, right};
   for (int side = 0; side < 2; ++side) {
     // Trusted again: the leg may have moved into the torso cloth while it was not met (an
@@ -378,8 +379,7 @@ void GarmentSim::setLegsTrusted(bool left, bool right) {
 }
 
 void GarmentSim::applyLegGroups() {
-  const uint8_t legBit[2] = {static_cast<uint8_t>(1u << static_cast<int>(Chain::LegL)),
-                             static_cast<uint8_t>(1u << static_cast<int>(Chain::LegR))};
+  const uint8_t legBit[2] = {chainGroup(Chain::LegL), chainGroup(Chain::LegR)};
   const uint8_t overBit[2] = {kTorsoOverLegL, kTorsoOverLegR};
   bool changed = false;
   for (size_t k = 0; k < groups_.size() && k < base_groups_.size(); ++k) {
@@ -409,8 +409,7 @@ bool GarmentSim::torsoClothInside(const Ellipsoid& e, uint8_t over) const {
 
 void GarmentSim::updateLegClearance(const std::vector<Ellipsoid>& ellipsoids, uint8_t recheck_sides) {
   if (!torso_meets_legs_ || (unclear_legs_ == 0 && recheck_sides == 0)) return;
-  const uint8_t legL = static_cast<uint8_t>(1u << static_cast<int>(Chain::LegL));
-  const uint8_t legR = static_cast<uint8_t>(1u << static_cast<int>(Chain::LegR));
+  const uint8_t legL = chainGroup(Chain::LegL), legR = chainGroup(Chain::LegR);
   if (leg_clear_.size() != base_groups_.size()) leg_clear_.assign(base_groups_.size(), 1);
   for (size_t k = 0; k < ellipsoids.size(); ++k) {
     const size_t global = reach_.empty() ? k : static_cast<size_t>(reach_[k]);
@@ -427,7 +426,7 @@ void GarmentSim::updateLegClearance(const std::vector<Ellipsoid>& ellipsoids, ui
 }
 
 uint8_t GarmentSim::maskForChain(int chain) {
-  const auto bit = [](Chain c) { return static_cast<uint8_t>(1u << static_cast<int>(c)); };
+  const auto bit = chainGroup;
   switch (static_cast<Chain>(chain)) {
     case Chain::Torso:
     case Chain::Head: return bit(Chain::Torso) | bit(Chain::Head);

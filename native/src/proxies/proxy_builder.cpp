@@ -42,7 +42,7 @@ float ringSpacing(const BodyModel& body, int first, int count, int i) {
 }  // namespace
 
 uint8_t collisionGroups(const ProxySource& source) {
-  const auto bit = [](int chain) { return static_cast<uint8_t>(1u << std::clamp(chain, 0, kChainCount - 1)); };
+  const auto bit = [](int chain) { return chainGroup(static_cast<Chain>(std::clamp(chain, 0, kChainCount - 1))); };
   uint8_t groups = bit(static_cast<int>(source.chain));
   if (source.also_chain >= 0) groups = static_cast<uint8_t>(groups | bit(source.also_chain));
   return groups;

@@ -36,6 +36,8 @@ struct ProxySource {
 // The collision groups of an ellipsoid (bit 1 << chain per chain it belongs to): what cloth
 // collision groups (GarmentSim) and the garments' reach (cloth/garment_reach.h) test against.
 uint8_t collisionGroups(const ProxySource& source);
+// The collision group bit of a body chain.
+inline constexpr uint8_t chainGroup(Chain c) { return static_cast<uint8_t>(1u << static_cast<int>(c)); }
 // Two group bits above the chains' (GarmentSim::maskFor, setLegsTrusted): the torso cloth of a
 // template garment over the left / right leg. A leg's ellipsoids carry them while the leg is
 // trusted; collisionGroups() never sets them.
