@@ -40,8 +40,8 @@ bool PenetrationMeter::setBody(const std::vector<drape_vec3>& positions, const s
 
 void PenetrationMeter::addFrame(const drape_vec3* vertices, size_t count) {
   for (size_t i = 0; i < count; ++i) {
-    const float sd = bvh_.signedDistance(drape::Vec3(vertices[i].x, vertices[i].y, vertices[i].z));
-    const double depth = sd < 0.0f ? -static_cast<double>(sd) * 1000.0 : 0.0;
+    // The library's measure (GarmentSim::measure): inside by the winding number.
+    const double depth = static_cast<double>(bvh_.depthInside(drape::Vec3(vertices[i].x, vertices[i].y, vertices[i].z))) * 1000.0;
     depth_mm_.push_back(depth);
     if (depth > 2.0) ++deep_;
   }

@@ -725,7 +725,8 @@ namespace Drape
         public float P99Stretch;
         /// <summary>mean_stretch.</summary>
         public float MeanStretch;
-        /// <summary>body_penetration_p99_mm: depth of vertices inside the body mesh (0 before an update).</summary>
+        /// <summary>body_penetration_p99_mm: depth of vertices inside the body mesh (0 before an update);
+        /// inside = winding number >= 1, depth = distance to the mesh.</summary>
         public float BodyPenetrationP99Mm;
         /// <summary>body_penetration_max_mm.</summary>
         public float BodyPenetrationMaxMm;

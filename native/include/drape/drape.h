@@ -627,7 +627,8 @@ typedef struct drape_garment_accuracy {
   float max_stretch;               /* structural edges: max of |len| / rest - 1 */
   float p99_stretch;               /* its 99th percentile */
   float mean_stretch;
-  float body_penetration_p99_mm;   /* depth of vertices inside the body mesh (0 before an update) */
+  float body_penetration_p99_mm;   /* depth of vertices inside the body mesh (0 before an update);
+                                      inside = winding number >= 1, depth = distance to the mesh */
   float body_penetration_max_mm;
   float deeper_than_2mm;           /* fraction of vertices more than 2 mm inside the body */
   /* Openings: the mesh's boundary loops (hem, collar, sleeve cuffs, trouser legs) that went

@@ -710,8 +710,9 @@ GarmentAccuracy GarmentSim::measure(const std::vector<Ellipsoid>& ellipsoids, co
     scratch.clear();
     size_t deep = 0;
     for (size_t i = 0; i < particleCount(); ++i) {
-      const float sd = bvh->signedDistance(x[i].head<3>());
-      const float depth = sd < 0.0f ? -sd * 1000.0f : 0.0f;
+      // Inside by the winding number, not the pseudo-normal sign: the body mesh intersects itself
+      // at the shoulder stitches and the crotch bridge, where that sign misreads points outside.
+      const float depth = bvh->depthInside(x[i].head<3>()) * 1000.0f;
       scratch.push_back(depth);
       if (depth > 2.0f) ++deep;
     }

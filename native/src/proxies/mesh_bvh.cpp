@@ -353,4 +353,89 @@ float TriangleBvh::signedDistance(const Vec3& p) const {
   return hitSign(p, h) * h.distance;
 }
 
+bool TriangleBvh::rayCrossings(const Vec3& p, const Eigen::Vector3d& d, int& crossings) const {
+  // Moller-Trumbore in double precision. Barycentric coordinates within kEdgeTol of a triangle's
+  // border make the ray ambiguous: it may cross the two triangles sharing that edge both or
+  // neither in float data, so the caller tries another direction.
+  constexpr double kEdgeTol = 1e-7;
+  const Eigen::Vector3d o = p.cast<double>();
+  const Eigen::Vector3d inv(1.0 / d.x(), 1.0 / d.y(), 1.0 / d.z());
+  crossings = 0;
+  uint32_t stack[kStackSize];
+  int sp = 0;
+  stack[sp++] = 0;
+  while (sp > 0) {
+    const Node& n = nodes_[stack[--sp]];
+    // Slab test, the box grown by a hair so that rounding never drops a triangle on its face.
+    double t_in = 0.0, t_out = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 3; ++k) {
+      const double a = (static_cast<double>(n.lo[k]) - 1e-6 - o[k]) * inv[k];
+      const double b = (static_cast<double>(n.hi[k]) + 1e-6 - o[k]) * inv[k];
+      t_in = std::max(t_in, std::min(a, b));
+      t_out = std::min(t_out, std::max(a, b));
+    }
+    if (t_in > t_out) continue;
+    if (n.count == 0) {
+      const uint32_t self = static_cast<uint32_t>(&n - nodes_.data());
+      stack[sp++] = n.first;
+      stack[sp++] = self + 1;
+      continue;
+    }
+    for (uint32_t s = n.first; s < n.first + n.count; ++s) {
+      const Eigen::Vector3d a = corners_[3 * s].cast<double>();
+      const Eigen::Vector3d e1 = corners_[3 * s + 1].cast<double>() - a;
+      const Eigen::Vector3d e2 = corners_[3 * s + 2].cast<double>() - a;
+      const Eigen::Vector3d pv = d.cross(e2);
+      const double det = e1.dot(pv);
+      const double scale = e1.norm() * e2.norm();
+      if (!(scale > 0.0)) continue;  // degenerate: bounds no volume
+      if (std::fabs(det) < 1e-9 * scale) {
+        // Along the plane: ambiguous only if the ray runs through the triangle's plane near p.
+        if (std::fabs((o - a).dot(e1.cross(e2))) < 1e-9 * scale) return false;
+        continue;
+      }
+      const Eigen::Vector3d tv = o - a;
+      const double u = tv.dot(pv) / det;
+      if (u < -kEdgeTol || u > 1.0 + kEdgeTol) continue;
+      const Eigen::Vector3d qv = tv.cross(e1);
+      const double v = d.dot(qv) / det;
+      if (v < -kEdgeTol || u + v > 1.0 + kEdgeTol) continue;
+      const double t = e2.dot(qv) / det;
+      if (t <= 0.0) continue;  // behind p (p on the surface itself: its depth is ~0 either way)
+      if (u < kEdgeTol || v < kEdgeTol || u + v > 1.0 - kEdgeTol) return false;
+      // det = -d . (e1 x e2): negative where the ray leaves through the (outward) face.
+      crossings += det < 0.0 ? 1 : -1;
+    }
+  }
+  return true;
+}
+
+int TriangleBvh::winding(const Vec3& p) const {
+  if (nodes_.empty() || !p.allFinite()) return 0;
+  // Three fixed directions in no symmetry plane of a body (none along an axis or a diagonal).
+  static const Eigen::Vector3d kDirs[3] = {Eigen::Vector3d(0.2673, 0.5345, 0.8018).normalized(),
+                                           Eigen::Vector3d(-0.7071, 0.3015, -0.6396).normalized(),
+                                           Eigen::Vector3d(0.5774, -0.8165, 0.1543).normalized()};
+  int crossings = 0;
+  for (const Eigen::Vector3d& d : kDirs)
+    if (rayCrossings(p, d, crossings)) return crossings;
+  // Every ray grazed an edge: the solid-angle sum over every triangle (Van Oosterom & Strackee).
+  const Eigen::Vector3d o = p.cast<double>();
+  double omega = 0.0;
+  for (size_t s = 0; s < tris_.size(); ++s) {
+    const Eigen::Vector3d a = corners_[3 * s].cast<double>() - o;
+    const Eigen::Vector3d b = corners_[3 * s + 1].cast<double>() - o;
+    const Eigen::Vector3d c = corners_[3 * s + 2].cast<double>() - o;
+    const double la = a.norm(), lb = b.norm(), lc = c.norm();
+    const double den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+    omega += 2.0 * std::atan2(a.dot(b.cross(c)), den);
+  }
+  return static_cast<int>(std::lround(omega / (4.0 * 3.14159265358979323846)));
+}
+
+float TriangleBvh::depthInside(const Vec3& p) const {
+  if (nodes_.empty() || winding(p) < 1) return 0.0f;
+  return closest(p).distance;
+}
+
 }  // namespace drape

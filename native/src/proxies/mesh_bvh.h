@@ -90,8 +90,25 @@ class TriangleBvh {
   // The same answer without the tree: every triangle tested (O(m)), for measurement and tests.
   Hit closestBruteForce(const Vec3& p) const;
 
-  // Signed distance to the mesh, negative inside; +inf for an empty tree.
+  // Signed distance to the mesh, negative inside; +inf for an empty tree. The sign is the local
+  // pseudo-normal rule above: wrong near surface buried inside another part of the solid.
   float signedDistance(const Vec3& p) const;
+
+  // Winding number of the (closed, outward-wound) mesh around p: 0 outside, 1 inside, 2 where two
+  // overlapping parts of the solid both contain p. Counted as the signed crossings of a ray from p
+  // (+1 where it leaves through a face, -1 where it enters), so a buried sheet crossed on the way
+  // out counts once each way and cancels: the answer is the generalised winding number's
+  // (body/mesh_metrics.h) rounded, at the cost of a ray query instead of a sum over every
+  // triangle. A ray that passes within a rounding tolerance of an edge or a vertex is discarded
+  // for another direction; after three such rays the solid-angle sum decides. 0 for an empty tree
+  // or a non-finite p.
+  int winding(const Vec3& p) const;
+  // Depth of p inside the solid the mesh bounds: its distance to the mesh where winding(p) >= 1,
+  // else 0. Unlike -signedDistance, a point outside the solid whose closest point lies on a buried
+  // sheet (the body's shoulder stitch, crotch bridge) is not inside; a point inside whose closest
+  // point is on such a sheet is, with its distance to that sheet (a lower bound of the depth to
+  // the outer surface). 0 for an empty tree or a non-finite p.
+  float depthInside(const Vec3& p) const;
   // Sign of a hit as described above: +1 outside (or on the surface), -1 inside.
   static float hitSign(const Vec3& p, const Hit& h) {
     return (p - h.point).dot(h.pseudo_normal) < 0.0f ? -1.0f : 1.0f;
@@ -121,6 +138,9 @@ class TriangleBvh {
   void refitBoxes();
   void testTriangle(uint32_t slot, const Vec3& p, float& best2, Hit& hit) const;
   void finishHit(const Vec3& p, Hit& hit) const;
+  // Signed crossings of the ray p + t d, t > 0, with the mesh; false when the ray passes too close
+  // to an edge or a vertex, or along a face's plane, to count them reliably.
+  bool rayCrossings(const Vec3& p, const Eigen::Vector3d& d, int& crossings) const;
 
   std::vector<Node> nodes_;
   std::vector<Tri> tris_;          // leaf order
