@@ -7,8 +7,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <memory>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace drape {
@@ -138,6 +140,44 @@ TEST(GarmentLegGroups, ThighsPlacedThroughTheHemWaitUntilItIsOut) {
   }
   std::printf("[ figures  ] at most %zu ellipsoids of a trusted leg waited for the hem to leave them\n", mostWaiting);
   EXPECT_GT(mostWaiting, 0u);
+}
+
+// A body shape change cuts the garments again (GarmentSim::refitted, both ways: the template made
+// again, and the cut carried by ring skinning): a template's torso cloth still meets the leg on
+// its side afterwards. (Until 2026-11-28 the new cut lost it.)
+TEST(GarmentLegGroups, RefitKeepsTheTorsoClothMeetingTheLegs) {
+  for (const bool remake : {true, false}) {
+    Context ctx(test::defaultDesc());
+    std::string err;
+    GarmentSim* g = test::addTemplate(ctx, GarmentKind::TShirt, 600, ClothSolverKind::Xpbd, GarmentSimParams{}, err);
+    ASSERT_NE(g, nullptr) << err;
+    auto torsoOverLegs = [&](const GarmentSim& garment) {
+      size_t torso = 0, over = 0;
+      for (uint8_t m : garment.particleMasks()) {
+        if (!(m & chainGroup(Chain::Torso)) || (m & (kLegBits | kArmBits))) continue;
+        ++torso;
+        over += ((m & kTorsoOverLegL) != 0) != ((m & kTorsoOverLegR) != 0);
+      }
+      return std::make_pair(torso, over);
+    };
+    const auto before = torsoOverLegs(*g);
+    ASSERT_GT(before.first, 0u);
+    EXPECT_EQ(before.second, before.first);
+    std::unique_ptr<GarmentSim> cut = g->refitted(ctx.restBody(), ctx.restEllipsoids(), ctx.restEllipsoidGroups(), err, remake);
+    ASSERT_NE(cut, nullptr) << err;
+    const auto after = torsoOverLegs(*cut);
+    EXPECT_GT(after.first, 0u) << (remake ? "template made again" : "ring skinning");
+    EXPECT_EQ(after.second, after.first) << (remake ? "template made again" : "ring skinning");
+    // Through the context: a taller, heavier person.
+    BodyShapeInput tall;
+    tall.height_m = 1.90f;
+    tall.weight_kg = 90.0f;
+    ASSERT_EQ(ctx.setShape(tall, err), DRAPE_OK) << err;
+    ASSERT_EQ(g->refits(), 1u);
+    const auto reshaped = torsoOverLegs(*g);
+    EXPECT_GT(reshaped.first, 0u);
+    EXPECT_EQ(reshaped.second, reshaped.first);
+  }
 }
 
 }  // namespace

@@ -320,8 +320,9 @@ std::unique_ptr<GarmentSim> GarmentSim::refitted(const BodyModel& body_rest,
     // (The replay takes the attachments from the layout; the triangles and the count are checked.)
     if (makeGarmentTemplate(body_rest, o.tmpl, mesh, why, nullptr, &o.layout) && mesh.indices == o.mesh.indices &&
         mesh.positions.size() == o.mesh.positions.size()) {
+      // The new cut keeps which cloth meets the legs (a template's torso cloth: createTemplate).
       std::unique_ptr<GarmentSim> g = create(mesh, o.topology, kind_, params_, o.dress_time_s, body_rest,
-                                             rest_ellipsoids, ellipsoid_groups, err);
+                                             rest_ellipsoids, ellipsoid_groups, err, false, torso_meets_legs_);
       if (g) g->origin_ = origin_;
       return g;
     }
@@ -334,7 +335,7 @@ std::unique_ptr<GarmentSim> GarmentSim::refitted(const BodyModel& body_rest,
   // shrank with the body, so the old offset in metres would put the pin inside or off the body).
   pinOffsetsFromPositions(body_rest, mesh);
   std::unique_ptr<GarmentSim> g = create(mesh, o.topology, kind_, params_, o.dress_time_s, body_rest,
-                                         rest_ellipsoids, ellipsoid_groups, err, true);
+                                         rest_ellipsoids, ellipsoid_groups, err, true, torso_meets_legs_);
   if (g) g->origin_ = origin_;
   return g;
 }
