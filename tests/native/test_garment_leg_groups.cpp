@@ -56,8 +56,8 @@ TEST(GarmentLegGroups, TemplateTorsoClothMeetsTheLegOnItsSide) {
 }
 
 // A leg the host does not trust (its hip or knee not Tracked: Context::beginStep) keeps its
-// ellipsoids from the torso cloth; the other leg's and every other ellipsoid's groups stay as
-// they were given.
+// ellipsoids from the torso cloth, and the pelvis fill (built from both thighs) too; the other
+// leg's and every other ellipsoid's groups stay as they were given.
 TEST(GarmentLegGroups, UntrustedLegIsPassedThrough) {
   Context ctx(test::defaultDesc());
   std::string err;
@@ -68,8 +68,13 @@ TEST(GarmentLegGroups, UntrustedLegIsPassedThrough) {
     g->setLegsTrusted(left, !left);
     const std::vector<uint8_t>& now = g->ellipsoidGroups();
     ASSERT_EQ(now.size(), base.size());
-    size_t legs = 0;
+    size_t legs = 0, pelvis = 0;
     for (size_t k = 0; k < base.size(); ++k) {
+      if (base[k] == kPelvisFillGroups) {
+        EXPECT_EQ(now[k], 0) << "the pelvis fill, ellipsoid " << k << ", met with a leg untrusted";
+        ++pelvis;
+        continue;
+      }
       EXPECT_EQ(now[k] & ~kOverBits, base[k]) << "ellipsoid " << k;
       if (base[k] & chainGroup(Chain::LegL)) {
         EXPECT_EQ((now[k] & kTorsoOverLegL) != 0, left) << "ellipsoid " << k;
@@ -82,11 +87,38 @@ TEST(GarmentLegGroups, UntrustedLegIsPassedThrough) {
       if (!(base[k] & kLegBits)) EXPECT_EQ(now[k] & kOverBits, 0) << "ellipsoid " << k;
     }
     EXPECT_GT(legs, 0u);
+    EXPECT_EQ(pelvis, 1u);
   }
   g->setLegsTrusted(true, true);
   for (size_t k = 0; k < base.size(); ++k) {
     if (base[k] & chainGroup(Chain::LegL)) EXPECT_NE(g->ellipsoidGroups()[k] & kTorsoOverLegL, 0);
     if (base[k] & chainGroup(Chain::LegR)) EXPECT_NE(g->ellipsoidGroups()[k] & kTorsoOverLegR, 0);
+    if (base[k] == kPelvisFillGroups) EXPECT_EQ(g->ellipsoidGroups()[k], kPelvisFillGroups);
+  }
+}
+
+// The pelvis fill is met by a T-shirt's torso cloth (both sides), not by template trousers (cut
+// round it instead), nor by an OBJ garment's cloth, which has no kTorsoOverLeg bits (the first test).
+TEST(GarmentLegGroups, PelvisFillMetByTopsNotByTrousers) {
+  Context ctx(test::defaultDesc());
+  const std::vector<uint8_t>& base = ctx.restEllipsoidGroups();
+  const auto fill = std::find(base.begin(), base.end(), kPelvisFillGroups);
+  ASSERT_NE(fill, base.end());
+  EXPECT_EQ(std::count(base.begin(), base.end(), kPelvisFillGroups), 1);
+  const size_t k = static_cast<size_t>(fill - base.begin());
+  for (GarmentKind kind : {GarmentKind::TShirt, GarmentKind::Dress, GarmentKind::Trousers}) {
+    std::string err;
+    GarmentSim* g = test::addTemplate(ctx, kind, 600, ClothSolverKind::Xpbd, GarmentSimParams{}, err);
+    ASSERT_NE(g, nullptr) << err;
+    const bool met = kind != GarmentKind::Trousers;
+    EXPECT_EQ(g->ellipsoidGroups()[k], met ? kPelvisFillGroups : 0) << garmentKindName(kind);
+    size_t meeting = 0;
+    for (uint8_t m : g->particleMasks()) meeting += (m & g->ellipsoidGroups()[k]) != 0;
+    if (met) {
+      EXPECT_GT(meeting, 0u) << garmentKindName(kind);
+    } else {
+      EXPECT_EQ(meeting, 0u) << garmentKindName(kind);
+    }
   }
 }
 

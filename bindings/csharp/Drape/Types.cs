@@ -416,8 +416,10 @@ namespace Drape
     }
 
     /// <summary>drape_ellipsoid (68 bytes): one tracking ellipsoid. A world point p is inside when
-    /// |diag(1/Radii) * [AxisX AxisY AxisZ]^T (p - Centre)| &lt; 1. With the Drape rule the last four
-    /// are fills: the shoulder fills (right, then left: Chain = the arm, Ring = its junction ring,
+    /// |diag(1/Radii) * [AxisX AxisY AxisZ]^T (p - Centre)| &lt; 1. With the Drape rule the last five
+    /// are fills: the pelvis fill (Chain = the torso, Ring = its hip ring, AxisY from between the
+    /// thighs up to the hip ring; met by a template garment's torso cloth, not trousers', while both
+    /// legs are tracked), the shoulder fills (right, then left: Chain = the arm, Ring = its junction ring,
     /// AxisY from the base of the neck to the shoulder joint; torso cloth collides with them too),
     /// then the hip fills (right, then left: Chain = the leg, Ring = its thigh ring, AxisY from the
     /// thigh ring up to the hip ring's side; cloth of that leg collides with them, and a template

@@ -298,7 +298,10 @@ DRAPE_API drape_result DRAPE_CALL drape_context_read_body_mesh(drape_context* co
 
 /* One tracking ellipsoid: world point p is inside when |diag(1/radii) * [axis_x axis_y axis_z]^T
  * (p - centre)| < 1. Axes are unit and orthogonal (a rotation); axis_y runs along the bone. With
- * the Drape rule the last four are fills (docs/proxies.md). First the shoulder fills (right, then
+ * the Drape rule the last five are fills (docs/proxies.md). First the pelvis fill: chain = the
+ * torso, ring = its first (hip) ring, axis_y from between the thighs' first rings up to the hip
+ * ring's centre; met by a template garment's torso cloth (not trousers') while both legs' hips and
+ * knees are tracked, by no other cloth. Then the shoulder fills (right, then
  * left): chain = the arm, ring = its junction ring, axis_y from the base of the neck to the
  * shoulder joint; cloth of the torso collides with them too. Then the hip fills (right, then
  * left): chain = the leg, ring = its first (thigh) ring, axis_y from the thigh ring up to the hip

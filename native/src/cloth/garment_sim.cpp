@@ -141,7 +141,7 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
                                                const std::vector<Ellipsoid>& rest_ellipsoids,
                                                const std::vector<uint8_t>& ellipsoid_groups,
                                                std::string& err, bool cut_from_dressed,
-                                               bool torso_meets_legs) {
+                                               TorsoReach torso_reach) {
   if (std::string e = validate(params); !e.empty()) {
     err = e;
     return nullptr;
@@ -190,8 +190,8 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
   g->groups_ = ellipsoid_groups;
   g->masks_.resize(g->mesh_.positions.size());
   for (size_t i = 0; i < g->masks_.size(); ++i)
-    g->masks_[i] = maskFor(body_rest, g->mesh_.positions[i], torso_meets_legs);
-  g->torso_meets_legs_ = torso_meets_legs;
+    g->masks_[i] = maskFor(body_rest, g->mesh_.positions[i], torso_reach != TorsoReach::Torso);
+  g->torso_reach_ = torso_reach;
   g->applyLegGroups();  // legs trusted (the rest body's, where the garment is dressed outside them)
   g->kind_ = solver;
   g->solver_ = makeSolver(solver, g->topology_);
@@ -289,8 +289,9 @@ std::unique_ptr<GarmentSim> GarmentSim::createTemplate(const GarmentTemplatePara
   GarmentMesh mesh;
   TemplateLayout layout;
   if (!makeGarmentTemplate(body_rest, tmpl, mesh, err, &layout)) return nullptr;
-  std::unique_ptr<GarmentSim> g = create(mesh, topo, solver, params, dress_time_s, body_rest, rest_ellipsoids,
-                                         ellipsoid_groups, err, false, /*torso_meets_legs=*/true);
+  std::unique_ptr<GarmentSim> g =
+      create(mesh, topo, solver, params, dress_time_s, body_rest, rest_ellipsoids, ellipsoid_groups, err, false,
+             tmpl.kind == GarmentKind::Trousers ? TorsoReach::Legs : TorsoReach::LegsAndPelvis);
   if (!g) return nullptr;
   auto origin = std::make_shared<Origin>(*g->origin_);
   origin->from_template = true;
@@ -322,7 +323,7 @@ std::unique_ptr<GarmentSim> GarmentSim::refitted(const BodyModel& body_rest,
         mesh.positions.size() == o.mesh.positions.size()) {
       // The new cut keeps which cloth meets the legs (a template's torso cloth: createTemplate).
       std::unique_ptr<GarmentSim> g = create(mesh, o.topology, kind_, params_, o.dress_time_s, body_rest,
-                                             rest_ellipsoids, ellipsoid_groups, err, false, torso_meets_legs_);
+                                             rest_ellipsoids, ellipsoid_groups, err, false, torso_reach_);
       if (g) g->origin_ = origin_;
       return g;
     }
@@ -335,7 +336,7 @@ std::unique_ptr<GarmentSim> GarmentSim::refitted(const BodyModel& body_rest,
   // shrank with the body, so the old offset in metres would put the pin inside or off the body).
   pinOffsetsFromPositions(body_rest, mesh);
   std::unique_ptr<GarmentSim> g = create(mesh, o.topology, kind_, params_, o.dress_time_s, body_rest,
-                                         rest_ellipsoids, ellipsoid_groups, err, true, torso_meets_legs_);
+                                         rest_ellipsoids, ellipsoid_groups, err, true, torso_reach_);
   if (g) g->origin_ = origin_;
   return g;
 }
@@ -386,6 +387,12 @@ void GarmentSim::applyLegGroups() {
   for (size_t k = 0; k < groups_.size() && k < base_groups_.size(); ++k) {
     uint8_t g = base_groups_[k];
     const bool clear = k >= leg_clear_.size() || leg_clear_[k];
+    if (g == kPelvisFillGroups) {
+      // The pelvis fill follows both thighs: met like a leg ellipsoid, while both legs are trusted
+      // and it is clear, and only by the garments whose torso reaches it (TorsoReach).
+      const bool met = torso_reach_ == TorsoReach::LegsAndPelvis && host_legs_[0] && host_legs_[1] && clear;
+      g = met ? kPelvisFillGroups : 0;
+    }
     for (int side = 0; side < 2; ++side)
       if (clear && host_legs_[side] && (g & legBit[side])) g = static_cast<uint8_t>(g | overBit[side]);
     changed = changed || groups_[k] != g;
@@ -409,16 +416,20 @@ bool GarmentSim::torsoClothInside(const Ellipsoid& e, uint8_t over) const {
 }
 
 void GarmentSim::updateLegClearance(const std::vector<Ellipsoid>& ellipsoids, uint8_t recheck_sides) {
-  if (!torso_meets_legs_ || (unclear_legs_ == 0 && recheck_sides == 0)) return;
+  if (torso_reach_ == TorsoReach::Torso || (unclear_legs_ == 0 && recheck_sides == 0)) return;
   const uint8_t legL = chainGroup(Chain::LegL), legR = chainGroup(Chain::LegR);
   if (leg_clear_.size() != base_groups_.size()) leg_clear_.assign(base_groups_.size(), 1);
   for (size_t k = 0; k < ellipsoids.size(); ++k) {
     const size_t global = reach_.empty() ? k : static_cast<size_t>(reach_[k]);
-    if (global >= base_groups_.size() || !(base_groups_[global] & (legL | legR))) continue;
-    const int side = (base_groups_[global] & legL) ? 0 : 1;
-    const bool recheck = (recheck_sides >> side) & 1u;
+    if (global >= base_groups_.size()) continue;
+    const uint8_t base = base_groups_[global];
+    const bool pelvis = base == kPelvisFillGroups;
+    if (!pelvis && !(base & (legL | legR))) continue;
+    // A leg's ellipsoids hold the torso cloth of their side; the pelvis fill that of both.
+    const uint8_t over = pelvis ? kPelvisFillGroups : (base & legL) ? kTorsoOverLegL : kTorsoOverLegR;
+    const bool recheck = pelvis ? recheck_sides != 0 : ((recheck_sides >> ((base & legL) ? 0 : 1)) & 1u) != 0;
     if (leg_clear_[global] && !recheck) continue;  // met: nothing to decide
-    const bool holds = torsoClothInside(ellipsoids[k], side == 0 ? kTorsoOverLegL : kTorsoOverLegR);
+    const bool holds = torsoClothInside(ellipsoids[k], over);
     if (holds == !leg_clear_[global]) continue;
     leg_clear_[global] = holds ? 0 : 1;
     unclear_legs_ = holds ? unclear_legs_ + 1 : unclear_legs_ - 1;

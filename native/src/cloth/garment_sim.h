@@ -116,13 +116,18 @@ class GarmentSim {
   // gravity), as a tailor would let it out: for meshes made on another body (OBJ garments), which
   // sit tight on that body's skin and would otherwise be stretched by the ellipsoids' bulges and
   // the collision margin.
+  // What a garment's torso cloth meets beyond the torso's and the head's ellipsoids (maskFor,
+  // applyLegGroups): an OBJ garment nothing more; template trousers the leg on its side; the
+  // other templates that and the pelvis fill (proxies/proxy_builder.h), which trousers, their seat
+  // and crotch cut round it, do not meet: meeting it stretched their seat (docs/proxies.md).
+  enum class TorsoReach : uint8_t { Torso, Legs, LegsAndPelvis };
   static std::unique_ptr<GarmentSim> create(const GarmentMesh& mesh, const TopologyParams& topo,
                                             ClothSolverKind solver, const GarmentSimParams& params,
                                             float dress_time_s, const BodyModel& body_rest,
                                             const std::vector<Ellipsoid>& rest_ellipsoids,
                                             const std::vector<uint8_t>& ellipsoid_groups,
                                             std::string& err, bool cut_from_dressed = false,
-                                            bool torso_meets_legs = false);
+                                            TorsoReach torso_reach = TorsoReach::Torso);
   // A template garment: makeGarmentTemplate on body_rest, then create(). It remembers the template
   // and its layout, so refitted() cuts it again as that template on the new body.
   static std::unique_ptr<GarmentSim> createTemplate(const GarmentTemplateParams& tmpl, const TopologyParams& topo,
@@ -196,7 +201,7 @@ class GarmentSim {
   // the leg ellipsoids torso cloth meets this step).
   const std::vector<uint8_t>& ellipsoidGroups() const { return groups_; }
   static uint8_t maskForChain(int chain);
-  // Torso cloth of a template garment (create's torso_meets_legs) also collides with the leg on
+  // Torso cloth of a template garment (create's torso_reach) also collides with the leg on
   // its side, through the group bits kTorsoOverLegL / R (proxies/proxy_builder.h), which a leg's
   // ellipsoids carry only while that leg is trusted (setLegsTrusted) and clear of torso cloth
   // (updateLegClearance). Why: a shirt's hem hangs over the tops of the thighs, and when the hip
@@ -337,7 +342,7 @@ class GarmentSim {
   // ellipsoid is clear: it held no torso cloth when the garment was last placed on the body (first
   // frame, pose jump) or when the leg was last trusted again, or none since (leg_clear_, one entry
   // per ellipsoid; empty: all clear). Pushed out at once, cloth a leg had passed into tore.
-  bool torso_meets_legs_ = false;  // create's flag: a template's torso cloth has kTorsoOverLeg bits
+  TorsoReach torso_reach_ = TorsoReach::Torso;  // create's: not Torso = torso cloth has kTorsoOverLeg bits
   bool host_legs_[2] = {true, true};
   uint8_t recheck_legs_ = 0;  // bit per side: trusted again since the last step
   std::vector<uint8_t> leg_clear_;

@@ -42,6 +42,7 @@ float ringSpacing(const BodyModel& body, int first, int count, int i) {
 }  // namespace
 
 uint8_t collisionGroups(const ProxySource& source) {
+  if (source.only_groups != 0) return source.only_groups;
   const auto bit = [](int chain) { return chainGroup(static_cast<Chain>(std::clamp(chain, 0, kChainCount - 1))); };
   uint8_t groups = bit(static_cast<int>(source.chain));
   if (source.also_chain >= 0) groups = static_cast<uint8_t>(groups | bit(source.also_chain));
@@ -169,6 +170,38 @@ Ellipsoid ProxyBuilder::hipFill(const BodyModel& body, const HipStitch& s) const
   return fillInBox(body, c, y, hip.frame, s.hip, s.thigh, Vec3(kHipFillSection, 1.0f, kHipFillSection));
 }
 
+void ProxyBuilder::planPelvisFill(const BodyModel& body) {
+  const int K = body.ringPoints();
+  const int hip = body.chainFirstRing(Chain::Torso);
+  const int thighs[2] = {body.chainFirstRing(Chain::LegR), body.chainFirstRing(Chain::LegL)};
+  pelvis_hip_.clear();
+  pelvis_thighs_.clear();
+  for (int j = 0; j < K; ++j) {
+    const float theta = 2.0f * kPi * static_cast<float>(j) / static_cast<float>(K);
+    const float c = std::cos(theta), s = std::sin(theta);
+    pelvis_hip_.push_back({hip, c, s});
+    for (int thigh : thighs) pelvis_thighs_.push_back({thigh, c, s});
+  }
+}
+
+// The hip stitch's front and back, and the crotch between the thighs, which the hip fills (one
+// side each, 0.75 across) leave open: on the CMU takes, whose hip joints hang 16 cm below the
+// pelvis joint, the body mesh there stood up to 65 mm outside every ellipsoid and the T-shirt's
+// hem sank into the lower belly. The fill is the ellipsoid inscribed in the box of the whole hip
+// ring and both thigh rings, in a frame with y from the thighs' mid-point to the hip ring's centre
+// and x the hip ring's forward (docs/proxies.md, "Pelvis fill"). It follows the thighs, as the
+// body mesh's stitch does, so cloth meets it only while both legs are trusted
+// (GarmentSim::applyLegGroups).
+Ellipsoid ProxyBuilder::pelvisFill(const BodyModel& body) const {
+  const auto& rings = body.rings();
+  const RingPose& hip = rings[static_cast<size_t>(body.chainFirstRing(Chain::Torso))];
+  const Vec3& l = rings[static_cast<size_t>(body.chainFirstRing(Chain::LegL))].centre;
+  const Vec3& r = rings[static_cast<size_t>(body.chainFirstRing(Chain::LegR))].centre;
+  Vec3 y = hip.centre - 0.5f * (l + r);
+  y = y.norm() > 1e-6f ? Vec3(y.normalized()) : Vec3(hip.frame.col(1));
+  return fillInBox(body, hip.centre, y, hip.frame, pelvis_hip_, pelvis_thighs_, Vec3::Ones());
+}
+
 void ProxyBuilder::planSubRings(const BodyModel& body) {
   // Decided once, on the rings as first built, so the ellipsoid count never changes.
   const auto& rings = body.rings();
@@ -235,6 +268,7 @@ void ProxyBuilder::buildAll(const BodyModel& body, const SkeletonPose& pose) {
   if (subRings_.empty()) planSubRings(body);
   if (shoulders_[0].junction.empty()) planShoulderFills(body);
   if (hips_[0].thigh.empty()) planHipFills(body);
+  if (pelvis_hip_.empty()) planPelvisFill(body);
   const auto& rings = body.rings();
   const bool paper = rule_ == ProxyRule::Paper;
 
@@ -363,6 +397,13 @@ void ProxyBuilder::buildAll(const BodyModel& body, const SkeletonPose& pose) {
       e.radii = Vec3(std::max(0.45f * r.forward_m, 1e-3f), std::max(0.52f * len, 1e-3f),
                      std::max(0.45f * r.side_m, 1e-3f));
       add(e, {ends[a], last, -1});
+    }
+    // The pelvis fill (pelvisFill above): met by the torso cloth of the garments whose torso may
+    // lie over the legs (GarmentSim::maskFor), not by other torso cloth.
+    {
+      ProxySource src{Chain::Torso, body.chainFirstRing(Chain::Torso), -1, -1};
+      src.only_groups = kPelvisFillGroups;
+      if (!skipNext(src)) add(pelvisFill(body), src);
     }
     // Shoulder fills (shoulderFill above), right then left.
     for (int side = 0; side < 2; ++side) {

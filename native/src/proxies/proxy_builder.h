@@ -31,6 +31,9 @@ struct ProxySource {
   // first_ring = its junction ring) cover the stitch between the torso and the arm, which lies
   // under the yoke as much as under the sleeve, so they also count as the torso's.
   int also_chain = -1;
+  // When not 0, the ellipsoid's collision groups instead of its chains': the pelvis fill belongs to
+  // the torso cloth that may lie over the legs (kTorsoOverLegL | kTorsoOverLegR), not to the torso.
+  uint8_t only_groups = 0;
 };
 
 // The collision groups of an ellipsoid (bit 1 << chain per chain it belongs to): what cloth
@@ -40,9 +43,12 @@ uint8_t collisionGroups(const ProxySource& source);
 inline constexpr uint8_t chainGroup(Chain c) { return static_cast<uint8_t>(1u << static_cast<int>(c)); }
 // Two group bits above the chains' (GarmentSim::maskFor, setLegsTrusted): the torso cloth of a
 // template garment over the left / right leg. A leg's ellipsoids carry them while the leg is
-// trusted; collisionGroups() never sets them.
+// trusted; collisionGroups() sets them only for the pelvis fill (kPelvisFillGroups below).
 inline constexpr uint8_t kTorsoOverLegL = 1u << 6, kTorsoOverLegR = 1u << 7;
 static_assert(kChainCount <= 6, "the chain bits must stay below kTorsoOverLegL");
+// The pelvis fill's groups, and only its (ProxySource::only_groups): the torso cloth that may lie
+// over the legs meets it, on both sides, whether or not the legs are trusted.
+inline constexpr uint8_t kPelvisFillGroups = kTorsoOverLegL | kTorsoOverLegR;
 
 class ProxyBuilder {
  public:
@@ -107,6 +113,10 @@ class ProxyBuilder {
   void planHipFills(const BodyModel& body);
   Ellipsoid hipFill(const BodyModel& body, const HipStitch& stitch) const;
   HipStitch hips_[2];  // right, left; empty until the first build
+  // Pelvis fill (Drape rule): the hip ring's points and both thigh rings' points, found once.
+  std::vector<StitchPoint> pelvis_hip_, pelvis_thighs_;
+  void planPelvisFill(const BodyModel& body);
+  Ellipsoid pelvisFill(const BodyModel& body) const;
   std::vector<int> subRings_;        // per ring: sub-rings inserted before the next ring
   std::vector<RingPose> scratch_;    // one chain's rings and sub-rings
   std::vector<int> scratchRing_;     // the ring each of them belongs to
