@@ -247,6 +247,31 @@ std::array<float, 3> gapStats(std::vector<float> v) {
   return {static_cast<float>(sum / static_cast<double>(v.size())), v[v.size() * 9 / 10], v.back()};
 }
 
+// The hip stitch's gaps (hipStitchGapsMm) every tenth frame of the take, with and without some
+// fills: mean, P90 and max of each, printed as "`what`: ... without `without_what` ...".
+struct GapsWithAndWithout {
+  std::array<float, 3> with{}, without{};
+};
+GapsWithAndWithout hipStitchGapsWithAndWithout(TrackedTake& take, ProxyBuilder& ours, size_t with_skip,
+                                               size_t without_count_from_end, size_t without_skip,
+                                               const char* without_what) {
+  std::vector<float> with, without;
+  everyTenthFrame(take, ours, [&] {
+    const auto& e = ours.ellipsoids();
+    hipStitchGapsMm(take.body, e, e.size(), with, with_skip);
+    hipStitchGapsMm(take.body, e, e.size() - without_count_from_end, without, without_skip);
+  });
+  GapsWithAndWithout g;
+  EXPECT_FALSE(with.empty());
+  if (with.empty() || without.empty()) return g;
+  g.with = gapStats(with);
+  g.without = gapStats(without);
+  std::printf("  hip stitch outside the ellipsoids by %.1f mm on average, P90 %.1f, max %.1f; without the %s "
+              "%.1f, %.1f, %.1f\n", g.with[0], g.with[1], g.with[2], without_what, g.without[0], g.without[1],
+              g.without[2]);
+  return g;
+}
+
 // The one ellipsoid whose groups are kPelvisFillGroups (the Drape rule's, before the shoulder fills).
 size_t pelvisFillIndex(const std::vector<ProxySource>& sources) {
   size_t found = sources.size();
@@ -271,16 +296,10 @@ TEST_P(ProxiesOnRecording, HipFillsSpanTheHipStitch) {
   expectFillPair(ours.sources(), body, 2, Chain::LegR, Chain::LegL, 0);  // the other trouser leg passes it
   // Measured without the pelvis fill (PelvisFillCoversTheHipStitchWhereTheHipFillsDoNot).
   const size_t pelvis = pelvisFillIndex(ours.sources());
-  std::vector<float> with, without;
-  everyTenthFrame(take, ours, [&] {
-    const auto& e = ours.ellipsoids();
-    hipStitchGapsMm(body, e, e.size(), with, pelvis);
-    hipStitchGapsMm(body, e, e.size() - 2, without, pelvis);
-  });
-  ASSERT_FALSE(with.empty());
-  const auto w = gapStats(with), wo = gapStats(without);
-  std::printf("  %s: hip stitch outside the ellipsoids by %.1f mm on average, P90 %.1f, max %.1f; without the hip "
-              "fills %.1f, %.1f, %.1f\n", GetParam().file, w[0], w[1], w[2], wo[0], wo[1], wo[2]);
+  std::printf("  %s:\n", GetParam().file);
+  const GapsWithAndWithout g = hipStitchGapsWithAndWithout(take, ours, pelvis, 2, pelvis, "hip fills");
+  const auto& w = g.with;
+  const auto& wo = g.without;
   EXPECT_LE(w[0], wo[0]);
   EXPECT_LE(w[2], wo[2]);
   // Measured: on the CMU takes P90 28.0-29.1 mm without, 14.1-15.1 mm with; on the Kinect takes
@@ -303,16 +322,10 @@ TEST_P(ProxiesOnRecording, PelvisFillCoversTheHipStitchWhereTheHipFillsDoNot) {
   EXPECT_EQ(src.chain, Chain::Torso);
   EXPECT_EQ(src.first_ring, body.chainFirstRing(Chain::Torso));
   EXPECT_EQ(pelvis + 5, ours.sources().size()) << "the shoulder and hip fills stay the last four";
-  std::vector<float> with, without;
-  everyTenthFrame(take, ours, [&] {
-    const auto& e = ours.ellipsoids();
-    hipStitchGapsMm(body, e, e.size(), with, e.size());
-    hipStitchGapsMm(body, e, e.size(), without, pelvis);
-  });
-  ASSERT_FALSE(with.empty());
-  const auto w = gapStats(with), wo = gapStats(without);
-  std::printf("  %s: hip stitch outside the ellipsoids by %.1f mm on average, P90 %.1f, max %.1f; without the pelvis "
-              "fill %.1f, %.1f, %.1f\n", GetParam().file, w[0], w[1], w[2], wo[0], wo[1], wo[2]);
+  std::printf("  %s:\n", GetParam().file);
+  const GapsWithAndWithout g = hipStitchGapsWithAndWithout(take, ours, ours.sources().size(), 0, pelvis, "pelvis fill");
+  const auto& w = g.with;
+  const auto& wo = g.without;
   EXPECT_LE(w[0], wo[0]);
   EXPECT_LE(w[2], wo[2]);
   // Measured: on the CMU takes P90 14.1-15.1 mm without, 0 with, max 55.0-55.5 mm without,
