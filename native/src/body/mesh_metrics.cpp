@@ -72,20 +72,20 @@ double signedVolume(const std::vector<Vec3>& positions, const std::vector<uint32
   return six_v / 6.0;
 }
 
+double triangleSolidAngle(const Vec3& p, const Vec3& a3, const Vec3& b3, const Vec3& c3) {
+  const Eigen::Vector3d o = p.cast<double>();
+  const Eigen::Vector3d a = a3.cast<double>() - o, b = b3.cast<double>() - o, c = c3.cast<double>() - o;
+  const double la = a.norm(), lb = b.norm(), lc = c.norm();
+  const double num = a.dot(b.cross(c));
+  const double den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+  return 2.0 * std::atan2(num, den);
+}
+
 double windingNumber(const std::vector<Vec3>& positions, const std::vector<uint32_t>& indices,
                      const Vec3& point) {
-  // Van Oosterom & Strackee solid angle per triangle, summed, over 4 pi.
-  const Eigen::Vector3d p = point.cast<double>();
   double omega = 0.0;
-  for (size_t t = 0; t + 2 < indices.size(); t += 3) {
-    const Eigen::Vector3d a = positions[indices[t]].cast<double>() - p;
-    const Eigen::Vector3d b = positions[indices[t + 1]].cast<double>() - p;
-    const Eigen::Vector3d c = positions[indices[t + 2]].cast<double>() - p;
-    const double la = a.norm(), lb = b.norm(), lc = c.norm();
-    const double num = a.dot(b.cross(c));
-    const double den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-    omega += 2.0 * std::atan2(num, den);
-  }
+  for (size_t t = 0; t + 2 < indices.size(); t += 3)
+    omega += triangleSolidAngle(point, positions[indices[t]], positions[indices[t + 1]], positions[indices[t + 2]]);
   return omega / (4.0 * 3.14159265358979323846);
 }
 

@@ -28,6 +28,9 @@ double signedVolume(const std::vector<Vec3>& positions, const std::vector<uint32
 // Generalised winding number of a closed mesh around a point: ~1 inside, ~0 outside.
 double windingNumber(const std::vector<Vec3>& positions, const std::vector<uint32_t>& indices,
                      const Vec3& point);
+// Signed solid angle of triangle (a, b, c) seen from point p (Van Oosterom & Strackee), in
+// steradians: windingNumber sums it over the triangles and divides by 4 pi.
+double triangleSolidAngle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
 
 // Area-weighted vertex normals into `normals` (resized by the caller to positions.size()).
 void vertexNormals(const std::vector<Vec3>& positions, const std::vector<uint32_t>& indices,

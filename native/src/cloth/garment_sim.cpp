@@ -426,8 +426,9 @@ void GarmentSim::updateLegClearance(const std::vector<Ellipsoid>& ellipsoids, ui
     const bool pelvis = base == kPelvisFillGroups;
     if (!pelvis && !(base & (legL | legR))) continue;
     // A leg's ellipsoids hold the torso cloth of their side; the pelvis fill that of both.
-    const uint8_t over = pelvis ? kPelvisFillGroups : (base & legL) ? kTorsoOverLegL : kTorsoOverLegR;
-    const bool recheck = pelvis ? recheck_sides != 0 : ((recheck_sides >> ((base & legL) ? 0 : 1)) & 1u) != 0;
+    const int side = (base & legL) ? 0 : 1;
+    const uint8_t over = pelvis ? kPelvisFillGroups : side == 0 ? kTorsoOverLegL : kTorsoOverLegR;
+    const bool recheck = pelvis ? recheck_sides != 0 : ((recheck_sides >> side) & 1u) != 0;
     if (leg_clear_[global] && !recheck) continue;  // met: nothing to decide
     const bool holds = torsoClothInside(ellipsoids[k], over);
     if (holds == !leg_clear_[global]) continue;

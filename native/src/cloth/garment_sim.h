@@ -198,7 +198,7 @@ class GarmentSim {
   // their own part instead of being squeezed out through one of them.
   const std::vector<uint8_t>& particleMasks() const { return masks_; }
   // Each ellipsoid's collision groups now (the ones given to create, plus kTorsoOverLegL / R on
-  // the leg ellipsoids torso cloth meets this step).
+  // the leg ellipsoids torso cloth meets this step; the pelvis fill's 0 while nothing meets it).
   const std::vector<uint8_t>& ellipsoidGroups() const { return groups_; }
   static uint8_t maskForChain(int chain);
   // Torso cloth of a template garment (create's torso_reach) also collides with the leg on
@@ -336,7 +336,7 @@ class GarmentSim {
   GarmentSimParams params_;
   std::unique_ptr<Solver> solver_;
   EllipsoidCollider collider_;
-  std::vector<uint8_t> masks_, groups_;  // groups_: base_groups_ with the trusted legs' kTorsoOverLeg bits
+  std::vector<uint8_t> masks_, groups_;  // groups_: base_groups_ as met now (applyLegGroups)
   std::vector<uint8_t> base_groups_;      // each ellipsoid's collision groups, as given to create()
   // Torso cloth meets a leg's ellipsoid while the host trusts that leg (setLegsTrusted) and the
   // ellipsoid is clear: it held no torso cloth when the garment was last placed on the body (first

@@ -1,5 +1,7 @@
 #include "proxies/mesh_bvh.h"
 
+#include "body/mesh_metrics.h"
+
 #include <algorithm>
 #include <cmath>
 #include <utility>
@@ -419,17 +421,10 @@ int TriangleBvh::winding(const Vec3& p) const {
   int crossings = 0;
   for (const Eigen::Vector3d& d : kDirs)
     if (rayCrossings(p, d, crossings)) return crossings;
-  // Every ray grazed an edge: the solid-angle sum over every triangle (Van Oosterom & Strackee).
-  const Eigen::Vector3d o = p.cast<double>();
+  // Every ray grazed an edge: the solid-angle sum over every triangle (body/mesh_metrics.h).
   double omega = 0.0;
-  for (size_t s = 0; s < tris_.size(); ++s) {
-    const Eigen::Vector3d a = corners_[3 * s].cast<double>() - o;
-    const Eigen::Vector3d b = corners_[3 * s + 1].cast<double>() - o;
-    const Eigen::Vector3d c = corners_[3 * s + 2].cast<double>() - o;
-    const double la = a.norm(), lb = b.norm(), lc = c.norm();
-    const double den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-    omega += 2.0 * std::atan2(a.dot(b.cross(c)), den);
-  }
+  for (size_t s = 0; s < tris_.size(); ++s)
+    omega += triangleSolidAngle(p, corners_[3 * s], corners_[3 * s + 1], corners_[3 * s + 2]);
   return static_cast<int>(std::lround(omega / (4.0 * 3.14159265358979323846)));
 }
 

@@ -131,24 +131,30 @@ Ellipsoid ProxyBuilder::fillInBox(const BodyModel& body, const Vec3& c, const Ve
   return e;
 }
 
-void ProxyBuilder::planHipFills(const BodyModel& body) {
+std::vector<ProxyBuilder::StitchPoint> ProxyBuilder::ringStitchPoints(const BodyModel& body, int ring) {
   const int K = body.ringPoints();
-  const int hip = body.chainFirstRing(Chain::Torso);
+  std::vector<StitchPoint> points;
+  points.reserve(static_cast<size_t>(K));
+  for (int j = 0; j < K; ++j) {
+    const float theta = 2.0f * kPi * static_cast<float>(j) / static_cast<float>(K);
+    points.push_back({ring, std::cos(theta), std::sin(theta)});
+  }
+  return points;
+}
+
+void ProxyBuilder::planHipFills(const BodyModel& body) {
+  const std::vector<StitchPoint> hip = ringStitchPoints(body, body.chainFirstRing(Chain::Torso));
   for (int side = 0; side < 2; ++side) {
     HipStitch& s = hips_[side];
     s.thigh_ring = body.chainFirstRing(side == 1 ? Chain::LegL : Chain::LegR);
+    s.thigh = ringStitchPoints(body, s.thigh_ring);
     // The hip ring's half on this thigh's side: its points whose sideways coordinate (the ring
     // frame's z, ringPointAt) has the thigh's sign. A torso ring's z is the body's right (hip to
     // hip, BodyModel::placeRings), whatever the pose.
     const float side_sign = side == 1 ? -1.0f : 1.0f;
     s.hip.clear();
-    s.thigh.clear();
-    for (int j = 0; j < K; ++j) {
-      const float theta = 2.0f * kPi * static_cast<float>(j) / static_cast<float>(K);
-      const StitchPoint p{hip, std::cos(theta), std::sin(theta)};
+    for (const StitchPoint& p : hip)
       if (p.s * side_sign > 1e-4f) s.hip.push_back(p);
-      s.thigh.push_back({s.thigh_ring, p.c, p.s});
-    }
   }
 }
 
@@ -171,17 +177,9 @@ Ellipsoid ProxyBuilder::hipFill(const BodyModel& body, const HipStitch& s) const
 }
 
 void ProxyBuilder::planPelvisFill(const BodyModel& body) {
-  const int K = body.ringPoints();
-  const int hip = body.chainFirstRing(Chain::Torso);
-  const int thighs[2] = {body.chainFirstRing(Chain::LegR), body.chainFirstRing(Chain::LegL)};
-  pelvis_hip_.clear();
-  pelvis_thighs_.clear();
-  for (int j = 0; j < K; ++j) {
-    const float theta = 2.0f * kPi * static_cast<float>(j) / static_cast<float>(K);
-    const float c = std::cos(theta), s = std::sin(theta);
-    pelvis_hip_.push_back({hip, c, s});
-    for (int thigh : thighs) pelvis_thighs_.push_back({thigh, c, s});
-  }
+  pelvis_hip_ = ringStitchPoints(body, body.chainFirstRing(Chain::Torso));
+  pelvis_thighs_ = hips_[0].thigh;  // planned first (buildAll)
+  pelvis_thighs_.insert(pelvis_thighs_.end(), hips_[1].thigh.begin(), hips_[1].thigh.end());
 }
 
 // The hip stitch's front and back, and the crotch between the thighs, which the hip fills (one

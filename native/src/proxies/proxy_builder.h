@@ -9,8 +9,8 @@
 //    further apart than the local radius; long semi-axis = kOverlap x the larger neighbour
 //    spacing and cross-section scaled so the union neither dips between rings nor bulges at them
 //    by more than ~3 %; chain ends and bends reach only to their neighbour; after the ring
-//    ellipsoids, a slim cap per chain end, a fill per shoulder and one per hip (docs/proxies.md
-//    has the derivation and the measured before/after).
+//    ellipsoids, a slim cap per chain end, a fill under the pelvis, one per shoulder and one per
+//    hip (docs/proxies.md has the derivation and the measured before/after).
 #pragma once
 
 #include "body/body_model.h"
@@ -47,7 +47,7 @@ inline constexpr uint8_t chainGroup(Chain c) { return static_cast<uint8_t>(1u <<
 inline constexpr uint8_t kTorsoOverLegL = 1u << 6, kTorsoOverLegR = 1u << 7;
 static_assert(kChainCount <= 6, "the chain bits must stay below kTorsoOverLegL");
 // The pelvis fill's groups, and only its (ProxySource::only_groups): the torso cloth that may lie
-// over the legs meets it, on both sides, whether or not the legs are trusted.
+// over the legs meets it, on both sides, while both legs are trusted (GarmentSim::applyLegGroups).
 inline constexpr uint8_t kPelvisFillGroups = kTorsoOverLegL | kTorsoOverLegR;
 
 class ProxyBuilder {
@@ -93,6 +93,8 @@ class ProxyBuilder {
     std::vector<StitchPoint> neck, junction;
     int junction_ring = 0;
   };
+  // Ring `ring`'s K points, at the angles the body mesh puts its ring vertices (ringPointAt).
+  static std::vector<StitchPoint> ringStitchPoints(const BodyModel& body, int ring);
   // The centroid of `points` (from the rings, ringPointAt).
   static Vec3 centroid(const BodyModel& body, const std::vector<StitchPoint>& points);
   // A fill: the ellipsoid inscribed in the box of the points of `a` and `b` in the frame with y
@@ -113,7 +115,7 @@ class ProxyBuilder {
   void planHipFills(const BodyModel& body);
   Ellipsoid hipFill(const BodyModel& body, const HipStitch& stitch) const;
   HipStitch hips_[2];  // right, left; empty until the first build
-  // Pelvis fill (Drape rule): the hip ring's points and both thigh rings' points, found once.
+  // Pelvis fill (Drape rule): the hip ring's points and both thigh rings' (the hip fills'), found once.
   std::vector<StitchPoint> pelvis_hip_, pelvis_thighs_;
   void planPelvisFill(const BodyModel& body);
   Ellipsoid pelvisFill(const BodyModel& body) const;
