@@ -1,0 +1,111 @@
+#!/usr/bin/env python3
+"""Compares two quality matrices written by matrix.sh (docs/replay.md, "Quality matrix").
+
+    matrix_compare.py BEFORE_DIR AFTER_DIR [--only SUBSTRING] [--fail-if-different]
+
+One row per run present in both (take_garment): pooled P99 stretch, frames with an opening off,
+the mean share of vertices deeper than 2 mm in the body, the worst measured frame's body
+penetration P99, particle-frames inside an ellipsoid; then, per figure, in how many runs it is
+lower / higher / equal, and the geometric mean of the ratios after / before (runs where both are
+positive). Exit status: 0; 1 with --fail-if-different when any figure of any run differs (a
+determinism check: the same tree twice must give the same numbers); 2 on bad input.
+"""
+import json
+import math
+import os
+import sys
+
+# (name in the table, how to read it from stats.json's "garment", format)
+FIGURES = [
+    ("P99 stretch %", lambda g: 100.0 * g["p99_stretch"], "{:7.2f}"),
+    ("off frames", lambda g: float(g["openings"]["off_frames"]), "{:4.0f}"),
+    ("> 2 mm %", lambda g: 100.0 * g["deeper_than_2mm"], "{:6.2f}"),
+    ("worst P99 mm", lambda g: g["body_penetration_mm"]["p99"], "{:6.1f}"),
+    ("inside", lambda g: float(g["proxy_inside"]), "{:4.0f}"),
+]
+
+
+def load(directory):
+    runs = {}
+    for name in sorted(os.listdir(directory)):
+        if not name.endswith(".json"):
+            continue
+        with open(os.path.join(directory, name)) as f:
+            stats = json.load(f)
+        garment = stats.get("garment")
+        if not isinstance(garment, dict):
+            continue  # --garment none, or not a drape-replay stats file
+        runs[name[:-5]] = (garment, stats.get("frames"))
+    return runs
+
+
+def number(read, garment):
+    try:
+        v = read(garment)
+    except (KeyError, TypeError):
+        return None
+    return v if isinstance(v, (int, float)) and math.isfinite(v) else None
+
+
+def main(argv):
+    args = [a for a in argv if not a.startswith("--")]
+    only = None
+    if "--only" in argv:
+        i = argv.index("--only")
+        if i + 1 >= len(argv):
+            print("matrix_compare.py: --only needs a substring", file=sys.stderr)
+            return 2
+        only = argv[i + 1]
+        args.remove(only)
+    if len(args) != 2 or not all(os.path.isdir(a) for a in args):
+        print(__doc__, file=sys.stderr)
+        return 2
+    before, after = load(args[0]), load(args[1])
+    names = [n for n in before if n in after and (only is None or only in n)]
+    if not names:
+        print("matrix_compare.py: no run in both folders", file=sys.stderr)
+        return 2
+    missing = sorted(n for n in set(before) ^ set(after) if only is None or only in n)
+    width = max(len(n) for n in names)
+    print(f"{'run':{width}s}  " + "  ".join(f"{f[0]:>17s}" for f in FIGURES) + "   frames")
+    lower = [0] * len(FIGURES)
+    higher = [0] * len(FIGURES)
+    equal = [0] * len(FIGURES)
+    logs = [[] for _ in FIGURES]
+    differs = False
+    for n in names:
+        (gb, fb), (ga, fa) = before[n], after[n]
+        cells = []
+        for k, (_, read, fmt) in enumerate(FIGURES):
+            b, a = number(read, gb), number(read, ga)
+            if b is None or a is None:
+                cells.append(f"{'n/a':>17s}")
+                differs |= (b is None) != (a is None)
+                continue
+            cells.append(f"{fmt.format(b)} -> {fmt.format(a)}".rjust(17))
+            if a < b:
+                lower[k] += 1
+            elif a > b:
+                higher[k] += 1
+            else:
+                equal[k] += 1
+            differs |= a != b
+            if a > 0 and b > 0:
+                logs[k].append(math.log(a / b))
+        differs |= fb != fa
+        print(f"{n:{width}s}  " + "  ".join(cells) + f"   {fb}" + ("" if fb == fa else f" -> {fa}"))
+    print()
+    print(f"{len(names)} runs; per figure: lower / higher / equal after, geometric mean of after / before")
+    for k, (label, _, _) in enumerate(FIGURES):
+        gm = f"{math.exp(sum(logs[k]) / len(logs[k])):.3f}" if logs[k] else "n/a"
+        print(f"  {label:14s} {lower[k]:3d} / {higher[k]:3d} / {equal[k]:3d}   {gm}")
+    if missing:
+        print(f"in one folder only: {', '.join(missing)}")
+    if "--fail-if-different" in argv and (differs or missing):
+        print("matrix_compare.py: the two matrices differ", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
