@@ -5,7 +5,8 @@
 
 One row per run present in both (take_garment): pooled P99 stretch, frames with an opening off,
 the mean share of vertices deeper than 2 mm in the body, the worst measured frame's body
-penetration P99, particle-frames inside an ellipsoid; then, per figure, in how many runs it is
+penetration P99, particle-frames inside an ellipsoid (and how many frames were measured: the
+off-frame count is out of those); then, per figure, in how many runs it is
 lower / higher / equal, and the geometric mean of the ratios after / before (runs where both are
 positive). Exit status: 0; 1 with --fail-if-different when any figure of any run differs (a
 determinism check: the same tree twice must give the same numbers); 2 on bad input.
@@ -35,7 +36,7 @@ def load(directory):
         garment = stats.get("garment")
         if not isinstance(garment, dict):
             continue  # --garment none, or not a drape-replay stats file
-        runs[name[:-5]] = (garment, stats.get("frames"))
+        runs[name[:-5]] = (garment, garment.get("frames_measured"))
     return runs
 
 
@@ -67,7 +68,7 @@ def main(argv):
         return 2
     missing = sorted(n for n in set(before) ^ set(after) if only is None or only in n)
     width = max(len(n) for n in names)
-    print(f"{'run':{width}s}  " + "  ".join(f"{f[0]:>17s}" for f in FIGURES) + "   frames")
+    print(f"{'run':{width}s}  " + "  ".join(f"{f[0]:>17s}" for f in FIGURES) + "   measured frames")
     lower = [0] * len(FIGURES)
     higher = [0] * len(FIGURES)
     equal = [0] * len(FIGURES)
