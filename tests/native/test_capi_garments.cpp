@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -276,6 +277,13 @@ TEST(CApiGarments, BadGarmentInputIsRejectedAndCreatesNothing) {
   d.solver = 5;
   EXPECT_FAILS(DRAPE_ERROR_OUT_OF_RANGE, "drape_context_add_garment_template",
                drape_context_add_garment_template(ctx.get(), &d, nullptr, nullptr, &g));
+  for (int32_t cut : {-1, 3, 0x7fffffff}) {
+    drape_garment_desc_init(&d);
+    d.cut = cut;
+    EXPECT_FAILS(DRAPE_ERROR_OUT_OF_RANGE, "drape_context_add_garment_template",
+                 drape_context_add_garment_template(ctx.get(), &d, nullptr, nullptr, &g));
+    EXPECT_NE(std::string(lastError()).find("cut"), std::string::npos) << lastError();
+  }
   drape_garment_template t;
   drape_garment_template_init(&t);
   t.kind = 9;
@@ -322,6 +330,72 @@ TEST(CApiGarments, BadGarmentInputIsRejectedAndCreatesNothing) {
   EXPECT_FAILS(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_add_garment_obj_memory",
                drape_context_add_garment_obj_memory(ctx.get(), nullptr, 10, nullptr, nullptr, nullptr, &g));
   EXPECT_EQ(g, sentinel);
+}
+
+drape_garment* addTemplateCut(drape_context* ctx, int32_t kind, int32_t cut) {
+  drape_garment_desc d;
+  EXPECT_EQ(drape_garment_desc_init(&d), DRAPE_OK);
+  d.cut = cut;
+  drape_garment_template t;
+  EXPECT_EQ(drape_garment_template_init(&t), DRAPE_OK);
+  t.kind = kind;
+  t.particles = 600;
+  drape_garment* g = nullptr;
+  EXPECT_EQ(drape_context_add_garment_template(ctx, &d, &t, nullptr, &g), DRAPE_OK) << lastError();
+  return g;
+}
+
+uint32_t refitsOf(drape_garment* g) {
+  drape_garment_stats s;
+  s.struct_size = sizeof(s);
+  EXPECT_EQ(drape_garment_get_stats(g, &s), DRAPE_OK) << lastError();
+  return s.refits;
+}
+
+std::vector<drape_vec3> restOf(drape_garment* g) {
+  uint32_t vertices = 0, indices = 0;
+  EXPECT_EQ(drape_garment_get_mesh_size(g, &vertices, &indices), DRAPE_OK) << lastError();
+  std::vector<drape_vec3> rest(vertices);
+  EXPECT_EQ(drape_garment_read_rest_positions(g, rest.data(), vertices), DRAPE_OK) << lastError();
+  return rest;
+}
+
+// drape_garment_desc.cut: one garment's cut, whatever the context's garment_fit. A garment cut for
+// the skeleton is cut again when the tracker calibrates, in a context that cuts for the shape; a
+// garment cut for the shape in a context that cuts for the skeleton is not; CONTEXT follows the
+// context's choice.
+TEST(CApiGarments, AGarmentsOwnCutOverridesTheContexts) {
+  ContextPtr shapeCtx = makeContext();
+  drape_context_desc sd;
+  ASSERT_OK(drape_context_desc_init(&sd));
+  sd.garment_fit = DRAPE_GARMENT_FIT_SKELETON;
+  drape_context* raw = nullptr;
+  ASSERT_OK(drape_context_create(&sd, &raw));
+  ContextPtr skeletonCtx(raw);
+  drape_garment* top = addTemplateCut(shapeCtx.get(), DRAPE_GARMENT_TSHIRT, DRAPE_GARMENT_CUT_CONTEXT);
+  drape_garment* legs = addTemplateCut(shapeCtx.get(), DRAPE_GARMENT_TROUSERS, DRAPE_GARMENT_CUT_SKELETON);
+  drape_garment* kept = addTemplateCut(skeletonCtx.get(), DRAPE_GARMENT_TSHIRT, DRAPE_GARMENT_CUT_SHAPE);
+  drape_garment* follows = addTemplateCut(skeletonCtx.get(), DRAPE_GARMENT_TROUSERS, DRAPE_GARMENT_CUT_CONTEXT);
+  ASSERT_TRUE(top && legs && kept && follows);
+  const std::vector<drape_vec3> legsRest = restOf(legs), keptRest = restOf(kept);
+  for (int i = 0; i < 35; ++i) {
+    ASSERT_OK(pushAndStep(shapeCtx.get(), i));
+    ASSERT_OK(pushAndStep(skeletonCtx.get(), i));
+  }
+  EXPECT_EQ(refitsOf(top), 0u);
+  EXPECT_EQ(refitsOf(legs), 1u) << "cut for the skeleton in a context that cuts for the shape";
+  EXPECT_EQ(refitsOf(kept), 0u) << "cut for the shape in a context that cuts for the skeleton";
+  EXPECT_EQ(refitsOf(follows), 1u);
+  const std::vector<drape_vec3> legsAfter = restOf(legs), keptAfter = restOf(kept);
+  ASSERT_EQ(legsAfter.size(), legsRest.size());
+  auto same = [](const std::vector<drape_vec3>& a, const std::vector<drape_vec3>& b) {
+    return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](const drape_vec3& p, const drape_vec3& q) {
+             return p.x == q.x && p.y == q.y && p.z == q.z;
+           });
+  };
+  EXPECT_FALSE(same(legsRest, legsAfter)) << "the trousers cut again: a new rest shape";
+  EXPECT_TRUE(same(keptRest, keptAfter)) << "the T-shirt cut for the shape keeps its rest shape";
+  for (drape_garment* g : {top, legs, kept, follows}) EXPECT_TRUE(allFinite(snapshot(g)));
 }
 
 TEST(CApiGarments, CallerMeshAndObjGarments) {

@@ -96,7 +96,7 @@ namespace Drape.Tests
             Assert.Equal(0.2f, d.AreaDensity, 1e-6f);
             Assert.Equal(2u, d.MaxTethers);
             Assert.Equal(0.5f, d.DressTimeS);
-            Assert.Equal(0u, d.Reserved);
+            Assert.Equal(GarmentCut.Context, d.Cut);
 
             GarmentTemplate t = GarmentTemplate.CreateDefault();
             Assert.Equal(24u, t.StructSize);
@@ -247,6 +247,20 @@ namespace Drape.Tests
                 ReadAndCheck(f);
             }
 
+            // One garment cut for the skeleton (GarmentDesc.Cut) in a context that cuts for the shape:
+            // only that one is cut again at the calibration.
+            using (var mixed = new Context())
+            {
+                GarmentDesc skeleton = GarmentDesc.CreateDefault();
+                skeleton.Cut = GarmentCut.Skeleton;
+                using Garment top = mixed.AddGarment(Small());
+                using Garment legs = mixed.AddGarment(Small(), skeleton);
+                StepFrames(mixed, 31);
+                Assert.Equal(0u, top.Stats.Refits);
+                Assert.Equal(1u, legs.Stats.Refits);
+                ReadAndCheck(legs);
+            }
+
             // The same shape again changes nothing.
             var before = new Vector3f[vertices];
             g.ReadPositions(before);
@@ -354,6 +368,11 @@ namespace Drape.Tests
             GarmentDesc d = GarmentDesc.CreateDefault();
             d.AreaDensity = float.NaN;
             Assert.Equal(ResultCode.NonFinite, Assert.Throws<DrapeException>(() => ctx.AddGarment(Small(), d)).Code);
+            d = GarmentDesc.CreateDefault();
+            d.Cut = (GarmentCut)3;
+            e = Assert.Throws<DrapeException>(() => ctx.AddGarment(Small(), d));
+            Assert.Equal(ResultCode.OutOfRange, e.Code);
+            Assert.Contains("cut", e.NativeMessage);
             Assert.Equal(ResultCode.InvalidArgument,
                          Assert.Throws<DrapeException>(() => ctx.AddGarment(Small(), cloth: default(ClothParams))).Code);
             Assert.Empty(ctx.Garments);

@@ -180,7 +180,7 @@ namespace Drape.Tests
         // 128 bytes: C layout rules, checked with offsetof when this table was written).
         [Fact]
         public void GarmentDesc_Is24() => AssertLayout<GarmentDesc>(24,
-            ("StructSize", 0), ("Solver", 4), ("AreaDensity", 8), ("MaxTethers", 12), ("DressTimeS", 16), ("Reserved", 20));
+            ("StructSize", 0), ("Solver", 4), ("AreaDensity", 8), ("MaxTethers", 12), ("DressTimeS", 16), ("Cut", 20));
 
         [Fact]
         public void GarmentTemplate_Is24() => AssertLayout<GarmentTemplate>(24,
@@ -343,6 +343,7 @@ namespace Drape.Tests
             new object[] { "drape_layout", typeof(Layout) },
             new object[] { "drape_proxy_rule", typeof(ProxyRule) },
             new object[] { "drape_garment_fit", typeof(GarmentFit) },
+            new object[] { "drape_garment_cut", typeof(GarmentCut) },
             new object[] { "drape_tracking_state", typeof(TrackingState) },
             new object[] { "drape_filter", typeof(Filter) },
             new object[] { "drape_sex", typeof(Sex) },

@@ -100,6 +100,18 @@ namespace Drape
         Skeleton = 1,
     }
 
+    /// <summary>drape_garment_cut: what proportions one garment is cut for (GarmentDesc.Cut).</summary>
+    public enum GarmentCut : int
+    {
+        /// <summary>DRAPE_GARMENT_CUT_CONTEXT: as the context's <see cref="ContextDesc.GarmentFit"/>. The default.</summary>
+        Context = 0,
+        /// <summary>DRAPE_GARMENT_CUT_SHAPE: the body shape's standard proportions, whatever the context's choice.</summary>
+        Shape = 1,
+        /// <summary>DRAPE_GARMENT_CUT_SKELETON: the tracked person's once the tracker has calibrated, whatever the
+        /// context's choice (e.g. trousers on Kinect data beside a top cut for the shape).</summary>
+        Skeleton = 2,
+    }
+
     /// <summary>drape_sex.</summary>
     public enum Sex : int
     {
@@ -484,8 +496,9 @@ namespace Drape
         public uint MaxTethers;
         /// <summary>dress_time_s: settling on the rest pose when added, [0, 10]; default 0.5.</summary>
         public float DressTimeS;
-        /// <summary>reserved: 0.</summary>
-        public uint Reserved;
+        /// <summary>cut (int32_t in C): what proportions this garment is cut for; default
+        /// <see cref="GarmentCut.Context"/> (the context's <see cref="ContextDesc.GarmentFit"/>).</summary>
+        public GarmentCut Cut;
 
         /// <summary>The library's defaults (drape_garment_desc_init).</summary>
         public static unsafe GarmentDesc CreateDefault()

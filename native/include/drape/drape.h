@@ -411,6 +411,18 @@ typedef enum drape_contact_response {
   DRAPE_CONTACT_FORCE32 = 0x7fffffff
 } drape_contact_response;
 
+/* What proportions one garment is cut for (drape_garment_desc.cut): the context's choice
+ * (drape_context_desc.garment_fit) or its own, so that one person can wear a top cut for the body
+ * shape and trousers cut for their skeleton (on the shared Kinect takes the skeleton cut keeps
+ * trousers on the legs; on the CMU mocap takes it sinks garments deeper into the body:
+ * docs/garments.md, "One garment's cut"). */
+typedef enum drape_garment_cut {
+  DRAPE_GARMENT_CUT_CONTEXT = 0,  /* as drape_context_desc.garment_fit says (default) */
+  DRAPE_GARMENT_CUT_SHAPE = 1,    /* as DRAPE_GARMENT_FIT_SHAPE, whatever the context's choice */
+  DRAPE_GARMENT_CUT_SKELETON = 2, /* as DRAPE_GARMENT_FIT_SKELETON, whatever the context's choice */
+  DRAPE_GARMENT_CUT_FORCE32 = 0x7fffffff
+} drape_garment_cut;
+
 /* How a garment is built, fixed for its life. */
 typedef struct drape_garment_desc {
   uint32_t struct_size;   /* sizeof(drape_garment_desc), set by drape_garment_desc_init */
@@ -418,7 +430,8 @@ typedef struct drape_garment_desc {
   float area_density;     /* kg/m^2, (0, 10]; 0.2 (a light cotton shirt) */
   uint32_t max_tethers;   /* long-range attachments per particle, [0, 8]; 2 */
   float dress_time_s;     /* settling on the rest pose when added, [0, 10]; 0.5 */
-  uint32_t reserved;      /* must be 0 */
+  int32_t cut;            /* drape_garment_cut; default DRAPE_GARMENT_CUT_CONTEXT (0: the former
+                             `reserved` field, so older callers keep their behaviour) */
 } drape_garment_desc;
 
 DRAPE_API drape_result DRAPE_CALL drape_garment_desc_init(drape_garment_desc* desc);

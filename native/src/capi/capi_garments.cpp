@@ -167,7 +167,7 @@ drape_result readCommon(const char* fn, const drape_garment_desc* desc, const dr
   k.range(w, "area_density", d.area_density, 1e-6f, 10.0f);
   k.range(w, "max_tethers", static_cast<float>(d.max_tethers), 0.0f, 8.0f);
   k.range(w, "dress_time_s", d.dress_time_s, 0.0f, 10.0f);
-  k.reserved(w, d.reserved);
+  k.range(w, "cut", static_cast<float>(d.cut), 0.0f, 2.0f);
   if (drape_result r = k.done(fn)) return r;
   drape_cloth_params c;
   drape_cloth_params_init(&c);
@@ -219,27 +219,28 @@ drape::TopologyParams topologyFrom(const drape_garment_desc& d) {
   return tp;
 }
 
-// Hands out a handle for a garment dressed on the context's rest body (null: `err` says why).
-drape_result adoptCreated(const char* fn, Context& ctx, std::unique_ptr<GarmentSim> g, const std::string& err,
-                          drape_garment** out) {
+// Hands out a handle for a garment dressed on the context's rest body for `cut` (null: `err` says why).
+drape_result adoptCreated(const char* fn, Context& ctx, Context::RestCut cut, std::unique_ptr<GarmentSim> g,
+                          const std::string& err, drape_garment** out) {
   if (!g) return fail(DRAPE_ERROR_INVALID_ARGUMENT, std::string(fn) + ": " + err);
   GarmentSim* raw = g.get();
   void* token = registerHandle(HandleKind::Garment, raw);
   raw->api_token = token;
   raw->api_owner = &ctx;
-  ctx.adoptGarment(std::move(g));
+  ctx.adoptGarment(std::move(g), cut);
   *out = static_cast<drape_garment*>(token);
   return DRAPE_OK;
 }
 
-// Dresses `mesh` on the context's rest body and hands out a handle.
+// Dresses `mesh` on the context's rest body for the desc's cut and hands out a handle.
 drape_result adopt(const char* fn, Context& ctx, const drape::GarmentMesh& mesh, const drape_garment_desc& d,
                    const drape::GarmentSimParams& sim, drape_garment** out, bool cut_from_dressed) {
   std::string err;
+  const Context::RestCut cut = ctx.cutFor(d.cut);
   auto g = GarmentSim::create(mesh, topologyFrom(d), static_cast<drape::ClothSolverKind>(d.solver), sim,
-                              d.dress_time_s, ctx.restBody(), ctx.restEllipsoids(), ctx.restEllipsoidGroups(), err,
-                              cut_from_dressed);
-  return adoptCreated(fn, ctx, std::move(g), err, out);
+                              d.dress_time_s, ctx.restBody(cut), ctx.restEllipsoids(cut), ctx.restEllipsoidGroups(cut),
+                              err, cut_from_dressed);
+  return adoptCreated(fn, ctx, cut, std::move(g), err, out);
 }
 
 drape_result addFitted(const char* fn, Context& ctx, const drape::ObjMesh& obj, const drape_mesh_fit* fit,
@@ -248,7 +249,7 @@ drape_result addFitted(const char* fn, Context& ctx, const drape::ObjMesh& obj, 
   if (drape_result r = toFitParams(fn, fit, fp)) return r;
   drape::GarmentMesh mesh;
   std::string err;
-  if (!drape::fitObjGarment(obj, fp, ctx.restBody(), mesh, err))
+  if (!drape::fitObjGarment(obj, fp, ctx.restBody(ctx.cutFor(d.cut)), mesh, err))
     return fail(DRAPE_ERROR_INVALID_ARGUMENT, std::string(fn) + ": " + err);
   return adopt(fn, ctx, mesh, d, sim, out, /*cut_from_dressed=*/true);
 }
@@ -344,10 +345,11 @@ DRAPE_API drape_result DRAPE_CALL drape_context_add_garment_template(drape_conte
     tp.ease_m = t.ease_m;
     tp.length_scale = t.length_scale;
     std::string err;
+    const Context::RestCut cut = ctx->cutFor(d.cut);
     auto g = GarmentSim::createTemplate(tp, topologyFrom(d), static_cast<drape::ClothSolverKind>(d.solver), sim,
-                                        d.dress_time_s, ctx->restBody(), ctx->restEllipsoids(),
-                                        ctx->restEllipsoidGroups(), err);
-    return adoptCreated(fn, *ctx, std::move(g), err, out_garment);
+                                        d.dress_time_s, ctx->restBody(cut), ctx->restEllipsoids(cut),
+                                        ctx->restEllipsoidGroups(cut), err);
+    return adoptCreated(fn, *ctx, cut, std::move(g), err, out_garment);
   });
 }
 

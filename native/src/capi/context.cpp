@@ -116,7 +116,7 @@ drape_result Context::setShape(const BodyShapeInput& in, std::string& err) {
   auto useShape = [this](const ResolvedShape& shape) {
     shape_ = shape;
     body_->setShape(shape_);
-    restBody_.reset();  // rebuilt for the shape when next asked for
+    for (RestSlot& r : rest_) r.body.reset();  // rebuilt for the shape when next asked for
   };
   useShape(resolveShape(in));
   // Garments are refitted to the new body (GarmentSim::refitted, docs/garments.md "Body shape
@@ -135,24 +135,24 @@ drape_result Context::setShape(const BodyShapeInput& in, std::string& err) {
   return DRAPE_OK;
 }
 
-SkeletonPose Context::garmentRestPose() const {
-  return fitBones_ ? restPoseWithBones(shape_, kGarmentRestArmDownDeg, fittedBones_, &fittedTorso_)
-                   : restPose(shape_, kGarmentRestArmDownDeg);
+SkeletonPose Context::garmentRestPose(RestCut cut) const {
+  return cut == kCutSkeleton && fitBones_ ? restPoseWithBones(shape_, kGarmentRestArmDownDeg, fittedBones_, &fittedTorso_)
+                                          : restPose(shape_, kGarmentRestArmDownDeg);
 }
 
 void Context::fitGarmentsToSkeleton() {
-  // The garments so far were cut for other proportions (the shape's standard ones, or a previous
-  // calibration's): cut them again for this person, when their rest pose is another. Should a
-  // garment fail to dress on that body, every garment stays as it was, on the previous rest body,
-  // until the next calibration.
+  // The garments cut for the skeleton so far were cut for other proportions (the shape's standard
+  // ones, or a previous calibration's): cut them again for this person, when their rest pose is
+  // another. Should one fail to dress on that body, every garment stays as it was, on the previous
+  // rest body, until the next calibration. Garments cut for the shape are not touched.
   fittedCalibration_ = tracker_.calibrationCount();
   const SkeletonPose torso = torsoAverage_.empty() ? tracker_.pose() : torsoAverage_.mean();
   torsoAverage_.clear();  // the next calibration (a tracker reset) averages its own window
   const SkeletonPose fitted = restPoseWithBones(shape_, kGarmentRestArmDownDeg, tracker_.boneLengths(), &torso);
-  restBody();  // restPoseUsed_
+  const SkeletonPose current = garmentRestPose(kCutSkeleton);
   float moved = 0.0f;
   for (int j = 0; j < kJointCount; ++j)
-    moved = std::max(moved, (fitted.position[static_cast<size_t>(j)] - restPoseUsed_.position[static_cast<size_t>(j)]).norm());
+    moved = std::max(moved, (fitted.position[static_cast<size_t>(j)] - current.position[static_cast<size_t>(j)]).norm());
   if (!(moved >= kRefitBelowM)) return;  // this person has the proportions the garments were cut for
   const bool before = fitBones_;
   const std::array<float, kBoneCount> beforeBones = fittedBones_;
@@ -160,38 +160,47 @@ void Context::fitGarmentsToSkeleton() {
   fitBones_ = true;
   fittedBones_ = tracker_.boneLengths();
   fittedTorso_ = torso;
-  restBody_.reset();
+  rest_[kCutSkeleton].body.reset();
   std::string err;
-  if (!refitGarments(err, /*remake_templates=*/true)) {
+  const RestCut only = kCutSkeleton;
+  size_t refitted = 0;
+  if (!refitGarments(err, /*remake_templates=*/true, &only, &refitted)) {
     fitBones_ = before;
     fittedBones_ = beforeBones;
     fittedTorso_ = beforeTorso;
-    restBody_.reset();
+    rest_[kCutSkeleton].body.reset();
+    return;
   }
-  wakeAll();
-  proxyBounds_.clear();
+  // The adaptive pipeline's ellipsoid bounds come from the context's own cut's rest body.
+  if (contextCut() == kCutSkeleton) proxyBounds_.clear();
+  if (refitted > 0) wakeAll();
 }
 
-bool Context::refitGarments(std::string& err, bool remake_templates) {
-  std::vector<std::unique_ptr<GarmentSim>> refits;
-  refits.reserve(garments_.size());
+bool Context::refitGarments(std::string& err, bool remake_templates, const RestCut* only, size_t* refitted) {
+  std::vector<std::unique_ptr<GarmentSim>> refits(garments_.size());
   for (size_t i = 0; i < garments_.size(); ++i) {
+    const RestCut cut = garmentCuts_[i];
+    if (only && cut != *only) continue;
     std::string why;
-    refits.push_back(garments_[i]->refitted(restBody(), restEllipsoids(), restEllipsoidGroups(), why, remake_templates));
-    if (!refits.back()) {
+    refits[i] = garments_[i]->refitted(restBody(cut), restEllipsoids(cut), restEllipsoidGroups(cut), why, remake_templates);
+    if (!refits[i]) {
       err = "garment " + std::to_string(i) + " could not be dressed on the new body (" + why + ")";
       return false;
     }
   }
   ReachParams rp;
   rp.margin_m = options_.reach_margin_m;
+  size_t count = 0;
   for (size_t i = 0; i < garments_.size(); ++i) {
+    if (!refits[i]) continue;
     GarmentSim& g = *garments_[i];
     g.replaceWith(std::move(*refits[i]));
     adaptive_.removeGarment(&g);
     adaptive_.addGarment(&g, garmentReach(g, rp));
     applyBackend(g);
+    ++count;
   }
+  if (refitted) *refitted = count;
   return true;
 }
 
@@ -297,7 +306,8 @@ drape_result Context::update(std::string& err) {
     }
   }
   // The torso over the calibration window, for the garments' cut (fitGarmentsToSkeleton).
-  if (desc_.garment_fit == DRAPE_GARMENT_FIT_SKELETON && newPose && !tracker_.calibrated()) torsoAverage_.add(pose);
+  // Any garment may be cut for the skeleton (drape_garment_desc.cut), one added later too.
+  if (newPose && !tracker_.calibrated()) torsoAverage_.add(pose);
   finishFrameCounters();
   skips_.updates = updates_;
   // A body that moved wakes the garments before anything is built for the frame.
@@ -368,42 +378,46 @@ FidelityReport Context::measureFidelity() {
 
 namespace drape {
 
-const BodyModel& Context::restBody() {
-  if (!restBody_) {
+Context::RestCut Context::cutFor(int32_t garment_cut) const {
+  if (garment_cut == DRAPE_GARMENT_CUT_SHAPE) return kCutShape;
+  if (garment_cut == DRAPE_GARMENT_CUT_SKELETON) return kCutSkeleton;
+  return contextCut();
+}
+
+Context::RestSlot& Context::restSlot(RestCut cut) {
+  RestSlot& r = rest_[cut == kCutSkeleton ? 1 : 0];
+  if (!r.body) {
     BodyModelParams bp;
     bp.ring_points = static_cast<int>(desc_.ring_points);
     bp.rings_per_segment = static_cast<int>(desc_.rings_per_segment);
     auto b = std::make_unique<BodyModel>(shape_, bp);
-    const SkeletonPose pose = garmentRestPose();
+    const SkeletonPose pose = garmentRestPose(cut);
     b->update(pose);
-    restPoseUsed_ = pose;
     // The tracked body's builder, so the ellipsoids come in the same count and order as every
     // frame's (the plan of sub-rings is made on a builder's first build and depends on the
     // proportions: a fresh builder on a body with the person's bones can plan other ones).
-    restProxies_ = proxies_;
-    restProxies_.build(*b, pose);
-    restGroups_.clear();
-    for (const ProxySource& src : restProxies_.sources()) restGroups_.push_back(collisionGroups(src));
-    restBody_ = std::move(b);
+    r.proxies = proxies_;
+    r.proxies.build(*b, pose);
+    r.groups.clear();
+    for (const ProxySource& src : r.proxies.sources()) r.groups.push_back(collisionGroups(src));
+    r.body = std::move(b);
   }
-  return *restBody_;
+  return r;
 }
 
-const std::vector<uint8_t>& Context::restEllipsoidGroups() {
-  restBody();
-  return restGroups_;
-}
+const BodyModel& Context::restBody(RestCut cut) { return *restSlot(cut).body; }
 
-const std::vector<Ellipsoid>& Context::restEllipsoids() {
-  restBody();
-  return restProxies_.ellipsoids();
-}
+const std::vector<uint8_t>& Context::restEllipsoidGroups(RestCut cut) { return restSlot(cut).groups; }
 
-GarmentSim* Context::adoptGarment(std::unique_ptr<GarmentSim> garment) {
+const std::vector<Ellipsoid>& Context::restEllipsoids(RestCut cut) { return restSlot(cut).proxies.ellipsoids(); }
+
+GarmentSim* Context::adoptGarment(std::unique_ptr<GarmentSim> garment, RestCut cut) {
   ReachParams rp;
   rp.margin_m = options_.reach_margin_m;
   std::vector<ReachSphere> reach = garmentReach(*garment, rp);
+  garmentCuts_.reserve(garments_.size() + 1);
   garments_.push_back(std::move(garment));
+  garmentCuts_.push_back(cut);
   adaptive_.addGarment(garments_.back().get(), std::move(reach));
   reachDirty_ = true;
   applyBackend(*garments_.back());
@@ -415,6 +429,7 @@ bool Context::removeGarment(const GarmentSim* garment) {
     if (it->get() == garment) {
       adaptive_.removeGarment(garment);
       reachDirty_ = true;
+      garmentCuts_.erase(garmentCuts_.begin() + (it - garments_.begin()));
       garments_.erase(it);
       return true;
     }
@@ -445,9 +460,7 @@ drape_result Context::checkStep(float dt, std::string& err) const {
 
 drape_result Context::beginStep(float dt, std::string& err) {
   if (drape_result r = update(err)) return r;
-  if (desc_.garment_fit == DRAPE_GARMENT_FIT_SKELETON && tracker_.calibrated() &&
-      tracker_.calibrationCount() != fittedCalibration_)
-    fitGarmentsToSkeleton();
+  if (tracker_.calibrated() && tracker_.calibrationCount() != fittedCalibration_) fitGarmentsToSkeleton();
   stepT0_ = Clock::now();
   // Woken or new garments, or new options, since the frame's ellipsoids were built.
   if (reachDirty_ && updated_) buildProxies(tracker_.pose());
@@ -532,7 +545,12 @@ drape_result Context::stepContexts(Context* const* contexts, size_t count, float
 }
 
 GarmentAccuracy Context::measureGarment(const GarmentSim& garment) {
-  if (!updated_) return garment.measure(restEllipsoids(), nullptr, &restBody());
+  if (!updated_) {
+    RestCut cut = contextCut();
+    for (size_t i = 0; i < garments_.size(); ++i)
+      if (garments_[i].get() == &garment) cut = garmentCuts_[i];
+    return garment.measure(restEllipsoids(cut), nullptr, &restBody(cut));
+  }
   refreshBvh();
   return garment.measure(proxies().ellipsoids(), &bvh_, &body());
 }

@@ -46,14 +46,27 @@ class Context {
   FidelityReport measureFidelity();
   bool hasUpdate() const { return updated_; }
 
-  // Garments. The body in its rest pose for the current shape (what garments are fitted and
-  // dressed on), built on demand and cached until the shape changes.
-  const BodyModel& restBody();
-  const std::vector<Ellipsoid>& restEllipsoids();
+  // Garments. What proportions a garment is cut for (its RestCut): the shape's standard ones, or
+  // the person's bones once the tracker has calibrated them (before that, the shape's too).
+  enum RestCut : int { kCutShape = 0, kCutSkeleton = 1 };
+  // A garment desc's cut (drape_garment_cut, validated) as a RestCut: CONTEXT follows garment_fit.
+  RestCut cutFor(int32_t garment_cut) const;
+  RestCut contextCut() const {
+    return desc_.garment_fit == DRAPE_GARMENT_FIT_SKELETON ? kCutSkeleton : kCutShape;
+  }
+  // The body in its rest pose for a cut (what garments are fitted and dressed on), built on demand
+  // and cached until the shape or the person's fitted bones change. Without a cut: the context's
+  // own (drape_context_desc.garment_fit).
+  const BodyModel& restBody(RestCut cut);
+  const std::vector<Ellipsoid>& restEllipsoids(RestCut cut);
   // The collision groups of each ellipsoid (collisionGroups of its source; same order every frame).
-  const std::vector<uint8_t>& restEllipsoidGroups();
-  // Takes ownership; the garment is dressed already (GarmentSim::create with restBody()).
-  GarmentSim* adoptGarment(std::unique_ptr<GarmentSim> garment);
+  const std::vector<uint8_t>& restEllipsoidGroups(RestCut cut);
+  const BodyModel& restBody() { return restBody(contextCut()); }
+  const std::vector<Ellipsoid>& restEllipsoids() { return restEllipsoids(contextCut()); }
+  const std::vector<uint8_t>& restEllipsoidGroups() { return restEllipsoidGroups(contextCut()); }
+  // Takes ownership; the garment is dressed already (GarmentSim::create with restBody(cut)).
+  GarmentSim* adoptGarment(std::unique_ptr<GarmentSim> garment, RestCut cut);
+  GarmentSim* adoptGarment(std::unique_ptr<GarmentSim> garment) { return adoptGarment(std::move(garment), contextCut()); }
   // Destroys it; false when it is not this context's.
   bool removeGarment(const GarmentSim* garment);
   size_t garmentCount() const { return garments_.size(); }
@@ -93,25 +106,33 @@ class Context {
   bool bvhBuilt_ = false;
   void refreshBvh();
 
-  std::unique_ptr<BodyModel> restBody_;  // rest pose of the current shape, for garments
-  // With DRAPE_GARMENT_FIT_SKELETON, garments are cut on the rest pose with the person's bones once
-  // the tracker has calibrated them (before that, the shape's standard proportions). fitBones_ says
-  // which restBody() builds (garmentRestPose): from the bone lengths and averaged torso of the
-  // calibration fitted last; restPoseUsed_ is the pose it was built on.
+  // The rest body of each cut, its ellipsoids (from the tracked body's builder, so in the same
+  // count and order as every frame's) and their collision groups; `body` null until asked for.
+  struct RestSlot {
+    std::unique_ptr<BodyModel> body;
+    ProxyBuilder proxies;
+    std::vector<uint8_t> groups;
+  };
+  RestSlot rest_[2];
+  RestSlot& restSlot(RestCut cut);
+  // Garments cut for the skeleton are cut on the rest pose with the person's bones once the
+  // tracker has calibrated them (before that, the shape's standard proportions). fitBones_ says
+  // which pose the skeleton cut's rest body takes (garmentRestPose): from the bone lengths and
+  // averaged torso of the calibration fitted last.
   bool fitBones_ = false;
   std::array<float, kBoneCount> fittedBones_{};
   SkeletonPose fittedTorso_{};
   TorsoAverage torsoAverage_;  // the torso over the calibration window
-  SkeletonPose restPoseUsed_{};
   uint32_t fittedCalibration_ = 0;  // the tracker's calibrationCount() last seen
-  SkeletonPose garmentRestPose() const;
+  SkeletonPose garmentRestPose(RestCut cut) const;
   void fitGarmentsToSkeleton();
-  // Refits every garment to restBody() (after a shape change or the tracker's calibration): all
-  // of them or, when one cannot be dressed on the new body, none (err says which and why).
-  bool refitGarments(std::string& err, bool remake_templates);
-  ProxyBuilder restProxies_;
-  std::vector<uint8_t> restGroups_;
+  // Refits the garments (every one, or those cut for `only` when given) to their cut's rest body
+  // (after a shape change or the tracker's calibration): all of them or, when one cannot be
+  // dressed on the new body, none (err says which and why). `refitted` counts them.
+  bool refitGarments(std::string& err, bool remake_templates, const RestCut* only = nullptr,
+                     size_t* refitted = nullptr);
   std::vector<std::unique_ptr<GarmentSim>> garments_;
+  std::vector<RestCut> garmentCuts_;  // garments_[i]'s cut
   std::vector<Ellipsoid> stepEllipsoids_;  // the ellipsoids at the end of the last step
   bool teleportPending_ = false;           // a teleport since the last step
   double stepMs_ = 0.0;

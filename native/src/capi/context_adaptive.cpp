@@ -38,8 +38,8 @@ void Context::buildProxies(const SkeletonPose& pose) {
     return;
   }
   if (proxyBounds_.size() != total && !garments_.empty()) {
-    restBody();
-    proxyBounds_ = ellipsoidBoundRadii(*restBody_, restProxies_.ellipsoids(), restProxies_.sources());
+    const RestSlot& rest = restSlot(contextCut());
+    proxyBounds_ = ellipsoidBoundRadii(*rest.body, rest.proxies.ellipsoids(), rest.proxies.sources());
   }
   // The union of what the awake garments reach now; each garment is told its own share.
   fresh_.assign(total, 0);
