@@ -136,6 +136,33 @@ namespace Drape.Tests
              ?? throw new MissingMethodException(target.GetType().Name, method)).Invoke(target, null);
 
         [Fact]
+        public void DrapeDresser_CutForTheSkeleton_IsCutAgainOnceCalibrated()
+        {
+            var refits = new System.Collections.Generic.List<uint>();
+            foreach (GarmentCut cut in new[] { GarmentCut.Context, GarmentCut.Skeleton })
+            {
+                var go = new GameObject("person");
+                var source = go.AddComponent<RecordingJointSourceBehaviour>();
+                Set(source, "recording", new TextAsset(SyntheticKinect2.Csv(90)));
+                MeshFilter garmentFilter = go.AddComponent<MeshFilter>();
+                var dresser = go.AddComponent<DrapeDresser>();
+                Set(dresser, "garment", GarmentKind.Trousers);
+                Set(dresser, "particles", 400);
+                Set(dresser, "cut", cut);
+                Set(dresser, "garmentMesh", garmentFilter);
+                Message(dresser, "OnEnable");
+                Assert.True(dresser.enabled, string.Join("\n", UnityEngine.Debug.StandInLog));
+                Time.deltaTime = 1f / 30f;
+                for (int i = 0; i < 40; ++i) Message(dresser, "Update");
+                Assert.True(dresser.Loop.FramesAccepted >= 31, $"{dresser.Loop.FramesAccepted} frames accepted");
+                refits.Add(dresser.Garment.Stats.Refits);
+                Message(dresser, "OnDisable");
+            }
+            // The default context cuts for the shape: only the garment cut for the skeleton is cut again.
+            Assert.Equal(new uint[] { 0, 1 }, refits);
+        }
+
+        [Fact]
         public void DrapeDresser_UpdatesGarmentAndBodyMeshesEveryFrame_WithoutAllocating()
         {
             var go = new GameObject("person");

@@ -27,6 +27,8 @@ namespace Drape.Samples
         [SerializeField] private GarmentKind garment = GarmentKind.TShirt;
         [Tooltip("Cloth particles (0: the template's default, 2 000).")]
         [SerializeField] private int particles = 0;
+        [Tooltip("What the garment is cut for: Context (the context's GarmentFit, the shape's standard proportions by default), Shape, or Skeleton (cut again for the person's bones once the tracker has calibrated: on the Kinect takes this keeps trousers on the legs; docs/garments.md).")]
+        [SerializeField] private GarmentCut cut = GarmentCut.Context;
         [Tooltip("Receives the garment mesh (its sharedMesh is replaced).")]
         [SerializeField] private MeshFilter garmentMesh = null;
         [Tooltip("Normals from Drape (true) or Mesh.RecalculateNormals (false).")]
@@ -80,7 +82,9 @@ namespace Drape.Samples
                 _loop = new DressingLoop(FindSource());
                 GarmentTemplate tmpl = GarmentTemplate.CreateDefault(garment);
                 if (particles > 0) tmpl.Particles = (uint)particles;
-                _garment = _loop.Context.AddGarment(tmpl);
+                GarmentDesc desc = GarmentDesc.CreateDefault();
+                desc.Cut = cut;
+                _garment = _loop.Context.AddGarment(tmpl, desc);
 
                 _garmentPositions = new Vector3[_garment.VertexCount];
                 _garmentNormals = new Vector3[_garment.VertexCount];
