@@ -16,6 +16,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <map>
 #include <string>
 #include <utility>
@@ -268,6 +270,42 @@ TEST(GarmentTemplateMesh, NoFanUnderTheArmsOnTheArmsDownCut) {
             << weight << " kg";
       }
     }
+  }
+}
+
+// A top's hem goes as much lower as the person's hip joints sit lower below the pelvis than on the
+// shape's standard proportions, past 1 cm (a mocap skeleton's hips sit ~10 cm below its root: the
+// CMU takes, where a top cut for the skeleton ended at the belly), and no lower for hips that sit
+// as the standard's or higher (a Kinect's): docs/garments.md, "Tops on a mocap pelvis".
+TEST(GarmentTemplateMesh, TopsReachAsFarDownAsTheHipJoints) {
+  const ResolvedShape shape = Body::resolve(1.70f, 65.0f);
+  const SkeletonPose standard = restPose(shape, 65.0f);
+  auto hemBelowPelvis = [&](float hips_down, GarmentKind kind) {
+    SkeletonPose p = standard;
+    for (Joint j : {Joint::HipL, Joint::KneeL, Joint::AnkleL, Joint::FootL, Joint::HipR, Joint::KneeR,
+                    Joint::AnkleR, Joint::FootR})
+      p.position[static_cast<size_t>(idx(j))].y() -= hips_down;
+    BodyModel model(shape, BodyModelParams{});
+    model.update(p);
+    GarmentTemplateParams tp;
+    tp.kind = kind;
+    tp.target_particles = 1000;
+    GarmentMesh mesh;
+    std::string err;
+    EXPECT_TRUE(makeGarmentTemplate(model, tp, mesh, err)) << err;
+    float lowest = std::numeric_limits<float>::infinity();
+    for (const Vec3& x : mesh.positions) lowest = std::min(lowest, x.y());
+    return p.position[static_cast<size_t>(idx(Joint::Pelvis))].y() - lowest;
+  };
+  for (GarmentKind kind : {GarmentKind::TShirt, GarmentKind::LongSleeve}) {
+    const float base = hemBelowPelvis(0.0f, kind);
+    const float higher = hemBelowPelvis(-0.02f, kind), slight = hemBelowPelvis(0.008f, kind);
+    const float mocap = hemBelowPelvis(0.08f, kind);
+    std::printf("[ figures  ] %s: hem %.4f m below the pelvis; hips 2 cm higher %.4f, 0.8 cm lower %.4f, 8 cm lower %.4f\n",
+                garmentKindName(kind), base, higher, slight, mocap);
+    EXPECT_NEAR(higher, base, 0.005f) << garmentKindName(kind);
+    EXPECT_NEAR(slight, base, 0.005f) << garmentKindName(kind);
+    EXPECT_NEAR(mocap - base, 0.08f, 0.015f) << garmentKindName(kind);
   }
 }
 

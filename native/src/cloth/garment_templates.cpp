@@ -57,6 +57,30 @@ Sec ringSec(const RingPose& r, float ease) {
 }
 
 // The section of a chain at station parameter u (clamped to the chain's rings), ease added.
+// How far the legs' first rings (the hip joints) sit below the hip ring (the pelvis), along its
+// axis, averaged over the two legs.
+float legRootDrop(const BodyModel& body) {
+  const RingPose& hip = body.rings()[static_cast<size_t>(body.chainFirstRing(Chain::Torso))];
+  float d = 0.0f;
+  for (Chain leg : {Chain::LegL, Chain::LegR})
+    d += (hip.centre - body.rings()[static_cast<size_t>(body.chainFirstRing(leg))].centre).dot(hip.frame.col(1));
+  return 0.5f * d;
+}
+
+// How much lower than on the shape's standard proportions this body's hip joints sit below its
+// pelvis, when that is more than 1 cm (else 0: a Kinect's hips sit level with its SpineBase, 0-2 cm
+// above the standard's): a mocap skeleton's sit ~10 cm below its root (the CMU takes, 9.6 cm), and
+// a top cut for that skeleton with its hem at the standard drop below the pelvis ring ends at the
+// belly. Measured on the rest body the garment is cut on.
+float extraHipDrop(const BodyModel& body) {
+  BodyModelParams bp;
+  bp.ring_points = body.ringPoints();
+  BodyModel standard(body.shape(), bp);
+  standard.updateRings(restPose(body.shape()));
+  const float extra = legRootDrop(body) - legRootDrop(standard);
+  return extra > 0.01f ? extra : 0.0f;
+}
+
 Sec chainSec(const BodyModel& body, Chain c, float u, float ease) {
   const int first = body.chainFirstRing(c), n = body.chainRingCount(c);
   const auto& st = body.stations();
@@ -132,6 +156,7 @@ class Builder {
     // Knee drop below the hip ring, along the hip ring's axis.
     const Sec knee = chainSec(body, Chain::LegL, 1.0f, 0.0f);
     kneeDrop_ = std::max(0.1f, (hip_.c - knee.c).dot(hip_.f.col(1)));
+    hipDrop_ = extraHipDrop(body);
     buildEnclosure();
   }
 
@@ -155,8 +180,8 @@ class Builder {
       rec_->h = h;
     }
     switch (p_.kind) {
-      case GarmentKind::TShirt: upper(h, 0.05f * p_.length_scale, false, 0.5f * p_.length_scale, m); break;
-      case GarmentKind::LongSleeve: upper(h, 0.05f * p_.length_scale, false, std::min(2.0f, 1.9f * p_.length_scale), m); break;
+      case GarmentKind::TShirt: upper(h, 0.05f * p_.length_scale + hipDrop_, false, 0.5f * p_.length_scale, m); break;
+      case GarmentKind::LongSleeve: upper(h, 0.05f * p_.length_scale + hipDrop_, false, std::min(2.0f, 1.9f * p_.length_scale), m); break;
       case GarmentKind::Dress: upper(h, 0.9f * kneeDrop_ * p_.length_scale, true, 0.35f * p_.length_scale, m); break;
       case GarmentKind::Skirt: skirt(h, m); break;
       case GarmentKind::Trousers: trousers(h, m); break;
@@ -575,6 +600,7 @@ class Builder {
   const std::vector<ProxySource>& src_;
   Sec hip_;
   float kneeDrop_ = 0.5f;
+  float hipDrop_ = 0.0f;  // extraHipDrop: tops' hems go as much lower
   std::vector<float> scale_;
 };
 
