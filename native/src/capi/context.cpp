@@ -385,7 +385,7 @@ Context::RestCut Context::cutFor(int32_t garment_cut) const {
 }
 
 Context::RestSlot& Context::restSlot(RestCut cut) {
-  RestSlot& r = rest_[cut == kCutSkeleton ? 1 : 0];
+  RestSlot& r = rest_[cut];  // kCutShape 0, kCutSkeleton 1
   if (!r.body) {
     BodyModelParams bp;
     bp.ring_points = static_cast<int>(desc_.ring_points);

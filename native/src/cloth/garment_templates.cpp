@@ -56,7 +56,6 @@ Sec ringSec(const RingPose& r, float ease) {
   return s;
 }
 
-// The section of a chain at station parameter u (clamped to the chain's rings), ease added.
 // How far the legs' first rings (the hip joints) sit below the hip ring (the pelvis), along its
 // axis, averaged over the two legs.
 float legRootDrop(const BodyModel& body) {
@@ -68,10 +67,11 @@ float legRootDrop(const BodyModel& body) {
 }
 
 // How much lower than on the shape's standard proportions this body's hip joints sit below its
-// pelvis, when that is more than 1 cm (else 0: a Kinect's hips sit level with its SpineBase, 0-2 cm
-// above the standard's): a mocap skeleton's sit ~10 cm below its root (the CMU takes, 9.6 cm), and
-// a top cut for that skeleton with its hem at the standard drop below the pelvis ring ends at the
-// belly. Measured on the rest body the garment is cut on.
+// pelvis, when that is more than 1 cm (else 0: a Kinect's hips sit level with its SpineBase or up
+// to 1 cm above it, 2-3 cm higher than the standard's 1.7 cm below): a mocap skeleton's sit ~10 cm
+// below its root (the CMU takes, 9.6 cm), and a top cut for that skeleton with its hem at the
+// standard drop below the pelvis ring ends at the belly. Measured on the rest body the garment is
+// cut on (docs/garments.md, "Tops on a mocap pelvis").
 float extraHipDrop(const BodyModel& body) {
   BodyModelParams bp;
   bp.ring_points = body.ringPoints();
@@ -81,6 +81,7 @@ float extraHipDrop(const BodyModel& body) {
   return extra > 0.01f ? extra : 0.0f;
 }
 
+// The section of a chain at station parameter u (clamped to the chain's rings), ease added.
 Sec chainSec(const BodyModel& body, Chain c, float u, float ease) {
   const int first = body.chainFirstRing(c), n = body.chainRingCount(c);
   const auto& st = body.stations();
