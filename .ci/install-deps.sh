@@ -12,6 +12,9 @@ packages+=(libbullet-dev gnuplot-nox)
 if [[ "${1:-}" != "--runtime-only" ]]; then
   # clang-15 brings libFuzzer (libclang-common-15-dev) for the fuzz targets tests/run.sh runs.
   packages+=(googletest libgtest-dev libbenchmark-dev clang-15)
+  # python3: the quality matrix's comparer, which CTest replay_matrix runs (samples/replay), and
+  # replay_default's JSON check; both are skipped where it is absent.
+  packages+=(python3)
 fi
 
 [[ "${1:-}" == "--runtime-only" ]] || packages+=(mono-complete)  # C# tests under Mono (docs/csharp.md)
