@@ -89,14 +89,16 @@ namespace Drape
         Drape = 1,
     }
 
-    /// <summary>drape_garment_fit: what proportions garments are cut for.</summary>
+    /// <summary>drape_garment_fit: what proportions garments are cut for (those whose
+    /// <see cref="GarmentDesc.Cut"/> is <see cref="GarmentCut.Context"/>, the default).</summary>
     public enum GarmentFit : int
     {
         /// <summary>DRAPE_GARMENT_FIT_SHAPE: the body shape's standard proportions only. The default.</summary>
         Shape = 0,
         /// <summary>DRAPE_GARMENT_FIT_SKELETON: the tracked person's. Once the tracker has calibrated the bone
-        /// lengths, every garment is cut again for their bones and torso (GarmentStats.Refits counts it;
-        /// particles and triangles stay, the rest shape changes).</summary>
+        /// lengths, every garment whose <see cref="GarmentDesc.Cut"/> follows the context is cut again for
+        /// their bones and torso (GarmentStats.Refits counts it; particles and triangles stay, the rest
+        /// shape changes).</summary>
         Skeleton = 1,
     }
 

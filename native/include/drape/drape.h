@@ -136,14 +136,15 @@ typedef enum drape_proxy_rule {
   DRAPE_PROXY_RULE_FORCE32 = 0x7fffffff
 } drape_proxy_rule;
 
-/* What proportions garments are cut for (drape_context_desc.garment_fit). */
+/* What proportions garments are cut for (drape_context_desc.garment_fit): those whose own cut
+ * (drape_garment_desc.cut) is DRAPE_GARMENT_CUT_CONTEXT, the default. */
 typedef enum drape_garment_fit {
   /* The body shape's standard proportions (drape_context_set_body_shape), whatever the skeleton.
    * Default. */
   DRAPE_GARMENT_FIT_SHAPE = 0,
   /* The tracked person's. Until the tracker has calibrated the bone lengths (calibration_frames),
-   * garments are cut for the shape's standard proportions; then every garment is cut again for this
-   * person: the rest pose takes their bone lengths and their torso's geometry (spine, hip and
+   * garments are cut for the shape's standard proportions; then every garment cut for the skeleton
+   * is cut again for this person: the rest pose takes their bone lengths and their torso's geometry (spine, hip and
    * shoulder joints) averaged over the calibration window, template garments are made again on it
    * with their first layout, OBJ garments carried to it (drape_garment_stats.refits counts it;
    * particles and triangles stay, the rest shape changes). No refit when the person's rest pose is

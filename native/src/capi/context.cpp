@@ -415,7 +415,7 @@ GarmentSim* Context::adoptGarment(std::unique_ptr<GarmentSim> garment, RestCut c
   ReachParams rp;
   rp.margin_m = options_.reach_margin_m;
   std::vector<ReachSphere> reach = garmentReach(*garment, rp);
-  garmentCuts_.reserve(garments_.size() + 1);
+  garmentCuts_.reserve(garments_.size() + 1);  // first: the two lists stay the same length
   garments_.push_back(std::move(garment));
   garmentCuts_.push_back(cut);
   adaptive_.addGarment(garments_.back().get(), std::move(reach));
@@ -546,6 +546,7 @@ drape_result Context::stepContexts(Context* const* contexts, size_t count, float
 
 GarmentAccuracy Context::measureGarment(const GarmentSim& garment) {
   if (!updated_) {
+    // Before the first update: on the rest body the garment was cut on.
     RestCut cut = contextCut();
     for (size_t i = 0; i < garments_.size(); ++i)
       if (garments_[i].get() == &garment) cut = garmentCuts_[i];
