@@ -184,8 +184,8 @@ void ProxyBuilder::planPelvisFill(const BodyModel& body) {
 
 // The hip stitch's front and back, and the crotch between the thighs, which the hip fills (one
 // side each, 0.75 across) leave open: on the CMU takes, whose hip stitch is 16 cm long (hip
-// joints 9-10 cm below the pelvis joint), the body mesh there stood up to 65 mm outside every ellipsoid and the T-shirt's
-// hem sank into the lower belly. The fill is the ellipsoid inscribed in the box of the whole hip
+// joints 9-10 cm below the pelvis joint), the body mesh there stood up to 65 mm outside every
+// ellipsoid and the T-shirt's hem sank into the lower belly. The fill is the ellipsoid inscribed in the box of the whole hip
 // ring and both thigh rings, in a frame with y from the thighs' mid-point to the hip ring's centre
 // and x the hip ring's forward (docs/proxies.md, "Pelvis fill"). It follows the thighs, as the
 // body mesh's stitch does, so cloth meets it only while both legs are trusted
