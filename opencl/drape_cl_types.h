@@ -59,10 +59,13 @@ typedef struct {
   dcl_u32 shape_offset, shape_count;               /* this frame: spans x shape_count shapes */
   dcl_u32 span_offset, flags;                      /* span bounds: 2 float4 per span */
   dcl_i32 substeps, stride;
-  dcl_i32 iterations, reserved;                    /* constraint passes per substep (>= 1) */
+  dcl_i32 iterations;                              /* constraint passes per substep (>= 1) */
+  dcl_i32 strain_passes;                           /* strain-limit passes in the last substep (0 = off) */
   float h, inv_n, h_drag, max_speed;
   float max_speed2, velocity_scale, tether_scale, static_friction;
-  float kinetic_friction, max_escape, pad0, pad1;
+  float kinetic_friction, max_escape;
+  float strain_scale;         /* 1 + XpbdParams::strain_limit: the longest a stretch edge may end a step */
+  float pad1;
   /* compliance / h^2 of this frame by constraint kind: alpha[0..2] the distance kinds in their
    * projection order (kDistanceKindOrder: shear, bend, stretch), alpha[3] the tethers. Kept out of
    * the constraints so that a new h (a Kinect's frame time varies every frame) changes 16 bytes
@@ -93,6 +96,13 @@ typedef struct {
 typedef struct {
   dcl_u32 tests, contacts, swept_catches, escapes;
 } DrapeClStats;
+
+/* How dcl_project_one (kernels.cl) projects a constraint: an equality on both ends (distance),
+ * the inequality |d| <= rest * scale on a only (tether: b is a pinned anchor), or the same
+ * inequality on both ends (the strain limit over the stretch groups, XpbdParams::strain_limit). */
+#define DCL_MODE_DISTANCE 0u
+#define DCL_MODE_TETHER 1u
+#define DCL_MODE_LIMIT 2u
 
 #ifdef __OPENCL_C_VERSION__
 /* Device helpers of the constraint record (xpbd_frame.cl, kernels.cl and phases.cl use them).

@@ -71,10 +71,11 @@ __kernel void drape_collide(__global const DrapeClGarment* g, __global float4* x
   if (st.escapes) atomic_add(&stats->escapes, st.escapes);
 }
 
-/* One distance constraint (both ends move) or tether (one-sided: only a moves, and only when
- * stretched past rest * tether_scale) projected in place in x: the Gauss-Seidel step of the
- * per-phase path (drape_phase_project, phases.cl) and of the per-kernel stage below. */
-inline void dcl_project_one(__global float4* x, const DrapeClConstraint c, uint tether, float tether_scale,
+/* One constraint projected in place in x, by `mode` (DCL_MODE_*, drape_cl_types.h): a distance
+ * constraint (both ends move), a tether (one-sided: only a moves, and only when stretched past
+ * rest * scale) or the strain limit (the tether's inequality, both ends moving). The Gauss-Seidel
+ * step of the per-phase path (drape_phase_project, phases.cl) and of the per-kernel stage below. */
+inline void dcl_project_one(__global float4* x, const DrapeClConstraint c, uint mode, float scale,
                             float alpha) {
   float4 pa = x[c.a], pb = x[c.b];
   const float3 d = pa.xyz - pb.xyz;
@@ -82,26 +83,27 @@ inline void dcl_project_one(__global float4* x, const DrapeClConstraint c, uint 
   if (!(len2 > 1e-18f)) return;
   const float y = rsqrt(len2);
   const float inv_w = dcl_inv_w(c.w_sum, alpha);
-  if (tether) {
-    const float c_len = fmax(len2 * y - c.rest * tether_scale, 0.0f);
+  if (mode == DCL_MODE_TETHER) {
+    const float c_len = fmax(len2 * y - c.rest * scale, 0.0f);
     pa.xyz -= (pa.w * c_len * y * inv_w) * d;
     x[c.a] = pa;
     return;
   }
-  const float s = (1.0f - c.rest * y) * inv_w;
+  const float s = mode == DCL_MODE_LIMIT ? fmax(len2 * y - c.rest * scale, 0.0f) * y * inv_w
+                                         : (1.0f - c.rest * y) * inv_w;
   pa.xyz -= (pa.w * s) * d;
   pb.xyz += (pb.w * s) * d;
   x[c.a] = pa;
   x[c.b] = pb;
 }
 
-/* One constraint colour group (tests): constraints [begin, end), one work-item each, alpha~ as
- * dcl_inv_w takes it. */
+/* One constraint colour group (tests): constraints [begin, end), one work-item each, projected
+ * by `mode` (DCL_MODE_*) with `scale` (tether / strain limit), alpha~ as dcl_inv_w takes it. */
 __kernel void drape_project_group(__global float4* x, __global const DrapeClConstraint* constraints,
-                                  uint begin, uint end, uint tether, float tether_scale, float alpha) {
+                                  uint begin, uint end, uint mode, float scale, float alpha) {
   const uint k = begin + get_global_id(0);
   if (k >= end) return;
-  dcl_project_one(x, constraints[k], tether, tether_scale, alpha);
+  dcl_project_one(x, constraints[k], mode, scale, alpha);
 }
 
 /* Area-weighted unit vertex normals (vertexNormals in body/mesh_metrics.cpp) without atomics:

@@ -12,7 +12,9 @@
  * substeps or iterations returns at once.
  *
  * Per substep s: drape_phase_predict, drape_phase_pins, per iteration one drape_phase_project
- * per distance group index then per tether group index, drape_phase_collide_velocity. The
+ * per distance group index then per tether group index; after a substep that is some garment's
+ * last, the strain limit's passes (one launch per stretch group index, each garment taking part
+ * only in its own last substep); drape_phase_collide_velocity. The
  * arithmetic per particle is the frame kernel's (xpbd_frame.cl), in the same order. */
 
 #define DCL_ROW_PARTICLES 0u
@@ -112,20 +114,32 @@ __kernel void drape_phase_pins(__global const DrapeClGarment* table, uint count,
   x[p] = (float4)(a.xyz + pin_t * (b.xyz - a.xyz), x[p].w);
 }
 
-/* Colour group `group` (distance, or tether when `tether`) of every garment that has one, in
- * pass `iteration` of substep `substep`; `row` = its row of `work`. */
+/* Whether garment g projects distance group `group` (or its tether group, `tether`) in pass
+ * `pass` of substep `substep`: the regular passes (limit = 0) in each of its substeps up to its
+ * iterations; the strain limit's (limit = 1) only in its own last substep, up to its
+ * strain_passes (0 when off), and only over its stretch groups (from kind_end[1]). */
+bool dcl_projects(__global const DrapeClGarment* g, uint group, uint tether, uint limit, int substep,
+                         int pass) {
+  if (limit) return substep + 1 == g->substeps && pass < g->strain_passes && !tether && group >= g->kind_end[1];
+  return substep < g->substeps && pass < g->iterations;
+}
+
+/* Colour group `group` of every garment that has one, in pass `iteration` of substep `substep`;
+ * `row` = its row of `work`; `mode` (DCL_MODE_*) a distance group, a tether group, or a distance
+ * group in the strain limit's passes (dcl_projects picks the garments). */
 __kernel void drape_phase_project(__global const DrapeClGarment* table, uint count,
                                   __global const uint* work, __global float4* x,
                                   __global const DrapeClConstraint* constraints,
-                                  __global const uint* groups, uint row, uint group, uint tether,
+                                  __global const uint* groups, uint row, uint group, uint mode,
                                   int substep, int iteration) {
   uint gi, j;
   if (!dcl_item(work, count, row, &gi, &j)) return;
   __global const DrapeClGarment* g = table + gi;
-  if (substep >= g->substeps || iteration >= g->iterations) return;
+  const uint tether = mode == DCL_MODE_TETHER ? 1u : 0u;
+  if (!dcl_projects(g, group, tether, mode == DCL_MODE_LIMIT ? 1u : 0u, substep, iteration)) return;
   const uint first = groups[(tether ? g->tether_group_offset : g->distance_group_offset) + group];
-  dcl_project_one(x + g->particle_offset, constraints[first + j], tether, g->tether_scale,
-                  dcl_group_alpha(g, group, tether));
+  dcl_project_one(x + g->particle_offset, constraints[first + j], mode,
+                  mode == DCL_MODE_LIMIT ? g->strain_scale : g->tether_scale, dcl_group_alpha(g, group, tether));
 }
 
 /* Consecutive colour groups (rows first_row .. first_row + rows - 1) small enough for one
@@ -135,25 +149,26 @@ __kernel void drape_phase_project(__global const DrapeClGarment* table, uint cou
  * runs the same arithmetic in the same order (the same bits). Garments whose colouring has many
  * small groups (a vertex of many edges needs as many colours: the templates' underarm fan, up to
  * 36 edges at 32 000 particles until it was removed, gave ~35 colours per kind) would otherwise
- * pay a launch for each of them. */
+ * pay a launch for each of them. `limit`: the strain limit's pass (distance rows only). */
 __kernel __attribute__((reqd_work_group_size(DRAPE_CL_WORK_GROUP, 1, 1)))
 void drape_phase_project_rows(__global const DrapeClGarment* table, uint count, __global const uint* work,
                               __global float4* x, __global const DrapeClConstraint* constraints,
                               __global const uint* groups, uint first_row, uint rows, uint distance_rows,
-                              int substep, int iteration) {
+                              int substep, int iteration, uint limit) {
   const uint lid = get_local_id(0);
   for (uint r = first_row; r < first_row + rows; ++r) {
     __global const uint* start = work + r * (count + 1u);
     const uint c = r - 2u;
     const uint tether = c >= distance_rows ? 1u : 0u;
     const uint group = tether ? c - distance_rows : c;
+    const uint mode = limit ? DCL_MODE_LIMIT : tether ? DCL_MODE_TETHER : DCL_MODE_DISTANCE;
     for (uint i = lid; i < start[count]; i += DRAPE_CL_WORK_GROUP) {
       const uint gi = dcl_owner(start, count, i);
       __global const DrapeClGarment* g = table + gi;
-      if (substep >= g->substeps || iteration >= g->iterations) continue;
+      if (!dcl_projects(g, group, tether, limit, substep, iteration)) continue;
       const uint first = groups[(tether ? g->tether_group_offset : g->distance_group_offset) + group];
-      dcl_project_one(x + g->particle_offset, constraints[first + i - start[gi]], tether, g->tether_scale,
-                      dcl_group_alpha(g, group, tether));
+      dcl_project_one(x + g->particle_offset, constraints[first + i - start[gi]], mode,
+                      limit ? g->strain_scale : g->tether_scale, dcl_group_alpha(g, group, tether));
     }
     barrier(CLK_GLOBAL_MEM_FENCE);
   }

@@ -97,6 +97,33 @@ void DCL_FRAME_BODY(__global const DrapeClGarment* g, DCL_XS float4* x, __global
         barrier(CLK_LOCAL_MEM_FENCE | CLK_GLOBAL_MEM_FENCE);
       }
     }
+    /* The strain limit (XpbdParams::strain_limit) in the frame's last substep, before collision:
+     * strain_passes passes over the stretch groups (the last distance kind, from kind_end[1]),
+     * each edge longer than rest * strain_scale pulled back to it, both ends moving. */
+    if (s + 1 == substeps) {
+      for (int pass = 0; pass < g->strain_passes; ++pass) {
+        for (uint c = g->kind_end[1]; c < g->distance_groups; ++c) {
+          const uint begin = groups[g->distance_group_offset + c];
+          const uint end = groups[g->distance_group_offset + c + 1];
+          const float alpha = dcl_group_alpha(g, c, 0u);
+          for (uint k = begin + lid; k < end; k += lsize) {
+            const DrapeClConstraint cst = constraints[k];
+            float4 pa = x[cst.a], pb = x[cst.b];
+            const float3 d = pa.xyz - pb.xyz;
+            const float len2 = dot(d, d);
+            if (!(len2 > 1e-18f)) continue;
+            const float y = rsqrt(len2);
+            const float c_len = fmax(len2 * y - cst.rest * g->strain_scale, 0.0f);
+            const float sc = c_len * y * dcl_inv_w(cst.w_sum, alpha);
+            pa.xyz -= (pa.w * sc) * d;
+            pb.xyz += (pb.w * sc) * d;
+            x[cst.a] = pa;
+            x[cst.b] = pb;
+          }
+          barrier(CLK_LOCAL_MEM_FENCE | CLK_GLOBAL_MEM_FENCE);
+        }
+      }
+    }
     /* 3. Collision (this span's ellipsoids), 4. velocities from positions, damping, clamp. */
     if (collide) {
       sp.shapes = shapes + g->shape_offset + (uint)span * g->shape_count;

@@ -174,6 +174,7 @@ int run(int argc, char** argv) {
     gdesc.solver = opt.solver;
     if (opt.substeps != 0) cloth.substep_hz = 30.0f * static_cast<float>(opt.substeps);
     if (opt.iterations != 0) cloth.iterations = opt.iterations;
+    if (opt.strain_limit >= 0.0) cloth.strain_limit = static_cast<float>(opt.strain_limit);
     else if (opt.solver == DRAPE_SOLVER_MASS_SPRING) cloth.substep_hz = kMassSpringSubstepHz;
     // A frame a little longer than 1/30 s must not hit the per-step cap (which would lengthen
     // every substep instead of adding some).
@@ -297,6 +298,7 @@ int run(int argc, char** argv) {
     st.solver = opt.solver;
     st.substep_hz = actual.substep_hz;
     st.iterations = actual.iterations;
+    st.strain_limit = actual.strain_limit;
     st.particles = garment_vertices;
     st.garment_triangles = garment_index_count / 3;
     st.attached = gs.attached;

@@ -263,6 +263,16 @@ bool parseOptions(int argc, const char* const* argv, Options& o, std::string& er
                 "' is not a whole number in [1, 64] (XPBD constraint passes per substep; 1 is the method)";
         return false;
       }
+    } else if (name == "--strain-limit") {
+      if (!takeValue()) return false;
+      double v = 0.0;
+      if (!parseDouble(value, v) || !(v >= 0.0 && v <= 10.0)) {
+        error = "--strain-limit '" + value +
+                "' is not a number in [0, 10] (structural edges are held to rest * (1 + it) at the end of "
+                "each step; 0 turns the limit off)";
+        return false;
+      }
+      o.strain_limit = v;
     } else if (name == "--measure-every" || name == "--garment-every") {
       if (!takeValue()) return false;
       if (!parseUint(value, 0, 0xffffffffUL, o.measure_every)) {
@@ -326,10 +336,15 @@ bool parseOptions(int argc, const char* const* argv, Options& o, std::string& er
   }
   // Garment options that the chosen garment would silently ignore are mistakes.
   if (o.garment_none && (o.particles != 0 || o.solver_given || o.substeps != 0 || o.iterations != 0 ||
-                         o.measure_given)) {
+                         o.strain_limit >= 0.0 || o.measure_given)) {
     error = std::string(o.particles != 0 ? "--particles" : o.solver_given ? "--solver"
-                        : o.substeps != 0 ? "--substeps" : o.iterations != 0 ? "--iterations" : "--measure-every") +
+                        : o.substeps != 0 ? "--substeps" : o.iterations != 0 ? "--iterations"
+                        : o.strain_limit >= 0.0 ? "--strain-limit" : "--measure-every") +
             " has no effect with --garment none; drop it or choose a garment";
+    return false;
+  }
+  if (o.strain_limit >= 0.0 && o.solver == DRAPE_SOLVER_MASS_SPRING) {
+    error = "--strain-limit has no effect with --solver massspring (an XPBD setting); drop it";
     return false;
   }
   if (o.iterations != 0 && o.solver == DRAPE_SOLVER_MASS_SPRING) {
@@ -411,6 +426,9 @@ std::string helpText() {
       "  --iterations N        XPBD constraint passes per substep, in [1, 64] (default 1, the\n"
       "                        method; with --substeps, e.g. --substeps 160 --iterations 4 is\n"
       "                        drape-bench's converged reference)\n"
+      "  --strain-limit F      XPBD: at the end of each step, structural edges longer than\n"
+      "                        rest * (1 + F) are pulled back to that length, F in [0, 10]\n"
+      "                        (default 0.1; 0 = off)\n"
       "  --measure-every N     measure the garment's accuracy (stretch, ellipsoid and body\n"
       "                        penetration; ~1 ms per 1 000 particles) every N frames (default 1;\n"
       "                        0 = never). Alias: --garment-every\n"

@@ -30,6 +30,7 @@ struct Options {
   bool solver_given = false;
   uint32_t substeps = 0;           // per 1/30 s frame; 0: the library default (or 2880 Hz for massspring)
   uint32_t iterations = 0;         // XPBD passes per substep, [1, 64]; 0: the library default (1)
+  double strain_limit = -1.0;      // XPBD strain limit, [0, 10]; < 0: the library default (0.1)
   uint32_t measure_every = 1;      // drape_garment_measure every N stepped frames; 0: never
   bool measure_given = false;
   std::string out_dir = "drape-out";

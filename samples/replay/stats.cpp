@@ -185,8 +185,10 @@ std::string statsJson(const ReplayStats& s) {
     w.key("substep_hz").value(s.substep_hz);
     if (s.solver == DRAPE_SOLVER_MASS_SPRING) {
       w.key("iterations").null();
+      w.key("strain_limit").null();
     } else {
       w.key("iterations").value(s.iterations);
+      w.key("strain_limit").value(s.strain_limit);
     }
   } else {
     w.key("kind").value("none");
@@ -194,6 +196,7 @@ std::string statsJson(const ReplayStats& s) {
     w.key("solver").null();
     w.key("substep_hz").null();
     w.key("iterations").null();
+    w.key("strain_limit").null();
   }
   w.key("triangles").value(s.garment_triangles);
   w.key("edges").value(static_cast<int64_t>(s.stretch.edgeCount()));

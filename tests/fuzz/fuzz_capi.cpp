@@ -311,7 +311,7 @@ struct Machine {
       c.spring_bend = in.inRange(0.0f, 1e6f);
       c.spring_damping = in.inRange(0.0f, 1e6f);
     }
-    if (mode & 32) c.reserved = in.u8();
+    if (mode & 32) c.strain_limit = in.inRange(-1.0f, 12.0f);  // outside [0, 10] is refused
     if (mode & 64) c.struct_size = in.u8();
   }
 

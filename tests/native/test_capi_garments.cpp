@@ -229,7 +229,9 @@ TEST(CApiGarments, BadParametersAreRejectedAndChangeNothing) {
       {"negative spring", [](drape_cloth_params& p) { p.spring_stretch = -3.0f; }, DRAPE_ERROR_OUT_OF_RANGE},
       {"iterations 0", [](drape_cloth_params& p) { p.iterations = 0; }, DRAPE_ERROR_OUT_OF_RANGE},
       {"iterations 65", [](drape_cloth_params& p) { p.iterations = 65; }, DRAPE_ERROR_OUT_OF_RANGE},
-      {"reserved", [](drape_cloth_params& p) { p.reserved = 1; }, DRAPE_ERROR_INVALID_ARGUMENT},
+      {"NaN strain_limit", [](drape_cloth_params& p) { p.strain_limit = kNaN; }, DRAPE_ERROR_NONFINITE},
+      {"negative strain_limit", [](drape_cloth_params& p) { p.strain_limit = -0.01f; }, DRAPE_ERROR_OUT_OF_RANGE},
+      {"strain_limit above 10", [](drape_cloth_params& p) { p.strain_limit = 11.0f; }, DRAPE_ERROR_OUT_OF_RANGE},
       {"struct_size", [](drape_cloth_params& p) { p.struct_size = 8; }, DRAPE_ERROR_INVALID_ARGUMENT},
   };
   for (const Case& c : cases) {

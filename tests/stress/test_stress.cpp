@@ -190,12 +190,15 @@ TEST(StressBones, ZeroLengthAndReversedBones) {
     // The garment is back on the body afterwards (recovery window: no more frames with an opening
     // off than the undisturbed run). Not yet after a zero-length spine: from its first frame (P99
     // stretch 151 %) one opening stays off to the end of the take; recovery-window median P99 0.21
-    // against 0.17 (docs/robustness.md, "Openings after a disturbance").
+    // against 0.17 (docs/robustness.md, "Openings after a disturbance"), 0.20 against 0.13 since
+    // the strain limit (which lowers the undisturbed run more than the one with a sleeve off):
+    // its median margin is 0.08 instead of 0.06.
     bool stays_on = true;
+    float median_margin = 0.06f;
   };
   const Case cases[] = {
       {"zero-length upper arms", [](Joints& j) { j[ElbowL].position = j[ShoulderL].position, j[ElbowR].position = j[ShoulderR].position; }},
-      {"zero-length spine", [](Joints& j) { j[SpineMid].position = j[SpineBase].position, j[SpineShoulder].position = j[SpineBase].position; }, false},
+      {"zero-length spine", [](Joints& j) { j[SpineMid].position = j[SpineBase].position, j[SpineShoulder].position = j[SpineBase].position; }, false, 0.08f},
       {"every joint at one point", [](Joints& j) { for (drape_joint& q : j) q.position = j[SpineBase].position; }},
       {"reversed forearms", [&](Joints& j) { reflect(j[WristL], j[ElbowL]), reflect(j[WristR], j[ElbowR]); }},
       {"reversed thighs (knees above hips)", [&](Joints& j) { reflect(j[KneeL], j[HipL]), reflect(j[KneeR], j[HipR]); }},
@@ -208,7 +211,7 @@ TEST(StressBones, ZeroLengthAndReversedBones) {
     });
     print(c.name, s);
     expectHealthy(s, c.name);
-    expectRecovered(s, control, end, c.name, 1.0, 0.06f, 0.12f, c.stays_on);
+    expectRecovered(s, control, end, c.name, 1.0, c.median_margin, 0.12f, c.stays_on);
   }
 }
 

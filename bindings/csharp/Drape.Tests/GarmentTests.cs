@@ -115,7 +115,7 @@ namespace Drape.Tests
             Assert.Equal(ContactResponse.Exact, c.ContactResponse);
             Assert.True(c.IsContinuousCollision);
             Assert.Equal(0.004f, c.CollisionMarginM, 1e-6f);
-            Assert.Equal(0u, c.Reserved);
+            Assert.Equal(0.1f, c.StrainLimit, 1e-6f);
 
             MeshFit f = MeshFit.CreateDefault();
             Assert.Equal(48u, f.StructSize);

@@ -193,7 +193,7 @@ namespace Drape.Tests
             ("BendCompliance", 60), ("TetherCompliance", 64), ("TetherScale", 68), ("StaticFriction", 72),
             ("KineticFriction", 76), ("CollisionMarginM", 80), ("ContactResponse", 84), ("ContinuousCollision", 88),
             ("LinearInertia", 92), ("AngularInertia", 96), ("BlendInS", 100), ("SpringStretch", 104),
-            ("SpringShear", 108), ("SpringBend", 112), ("SpringDamping", 116), ("Iterations", 120), ("Reserved", 124));
+            ("SpringShear", 108), ("SpringBend", 112), ("SpringDamping", 116), ("Iterations", 120), ("StrainLimit", 124));
 
         [Fact]
         public void MeshFit_Is48() => AssertLayout<MeshFit>(48,

@@ -608,8 +608,10 @@ namespace Drape
         /// <summary>iterations: XPBD constraint passes per substep, [1, 64]; default 1 (the
         /// mass-spring solver ignores it).</summary>
         public uint Iterations;
-        /// <summary>reserved: 0.</summary>
-        public uint Reserved;
+        /// <summary>strain_limit: XPBD, at the end of every step the structural edges longer than
+        /// rest * (1 + StrainLimit) are pulled back to that length (two passes, before the last
+        /// collision), [0, 10], 0 = off; default 0.1. The mass-spring solver ignores it.</summary>
+        public float StrainLimit;
 
         /// <summary><see cref="ContinuousCollision"/> as a bool.</summary>
         public bool IsContinuousCollision

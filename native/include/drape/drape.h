@@ -481,7 +481,12 @@ typedef struct drape_cloth_params {
   uint32_t iterations;         /* XPBD constraint passes per substep, [1, 64]; 1 (the method: more
                                   substeps beat more passes; drape-bench prices both). The
                                   mass-spring solver has no passes and ignores it */
-  uint32_t reserved;           /* must be 0 */
+  float strain_limit;          /* XPBD: at the end of every step the structural edges longer than
+                                  rest * (1 + strain_limit) are pulled back to that length (two
+                                  passes, before the last collision), [0, 10], 0 = off; 0.1.
+                                  Takes the place of a `reserved` field that had to be 0, so
+                                  older callers keep their behaviour (off). The mass-spring
+                                  solver ignores it */
 } drape_cloth_params;
 
 DRAPE_API drape_result DRAPE_CALL drape_cloth_params_init(drape_cloth_params* params);

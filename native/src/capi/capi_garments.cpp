@@ -85,7 +85,7 @@ drape_result toSimParams(const char* fn, const drape_cloth_params& c, drape::Gar
   k.range(w, "spring_bend", c.spring_bend, 0.0f, 1e6f);
   k.range(w, "spring_damping", c.spring_damping, 0.0f, 1e6f);
   k.range(w, "iterations", static_cast<float>(c.iterations), 1.0f, 64.0f);
-  k.reserved(w, c.reserved);
+  k.range(w, "strain_limit", c.strain_limit, 0.0f, 10.0f);
   if (drape_result r = k.done(fn)) return r;
   drape::GarmentSimParams p;
   p.substep_hz = c.substep_hz;
@@ -115,6 +115,7 @@ drape_result toSimParams(const char* fn, const drape_cloth_params& c, drape::Gar
   p.mass_spring.bend_stiffness = c.spring_bend;
   p.mass_spring.spring_damping = c.spring_damping;
   p.xpbd.iterations = static_cast<int>(c.iterations);
+  p.xpbd.strain_limit = c.strain_limit;
   const std::string e = drape::validate(p);
   if (!e.empty()) return fail(DRAPE_ERROR_OUT_OF_RANGE, std::string(fn) + ": cloth params: " + e);
   out = p;
@@ -151,6 +152,7 @@ void fromSimParams(const drape::GarmentSimParams& p, drape_cloth_params& c) {
   c.spring_bend = p.mass_spring.bend_stiffness;
   c.spring_damping = p.mass_spring.spring_damping;
   c.iterations = static_cast<uint32_t>(p.xpbd.iterations);
+  c.strain_limit = p.xpbd.strain_limit;
 }
 
 // Resolves the optional desc and cloth structs (NULL: defaults) and validates them.

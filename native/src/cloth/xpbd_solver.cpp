@@ -74,14 +74,20 @@ inline void scatter4(Vec4* x, const uint32_t* idx, __m128 px, __m128 py, __m128 
 }
 #endif
 
+// How a batch list is projected: Equality, C = |d| - rest (distance constraints); Tether, C =
+// max(|d| - rest * scale, 0) with only a moving (b is a pinned anchor); Limit, the same
+// inequality with both ends moving (the strain limit, XpbdParams::strain_limit).
+enum class Kind { Equality, Tether, Limit };
+
 // One XPBD iteration (lambda from 0) over a batch list: for each constraint, with
 // C = |d| - rest, d = a - b, and inv_w = 1 / (w_a + w_b + alpha~) (precomputed per step, 0 for
 // padding):  a -= w_a inv_w (C/|d|) d,  b += w_b inv_w (C/|d|) d.
-// Tethers (kTether): only a is written (b is a pinned anchor, w_b = 0), rest is scaled by `scale`
-// and only C > 0 acts (inequality). Constraints of a batch share no particle.
+// Tethers: only a is written (b is a pinned anchor, w_b = 0), rest is scaled by `scale` and only
+// C > 0 acts (inequality); Limit the same inequality on both ends. Constraints of a batch share
+// no particle.
 // 1/|d|: rsqrt estimate + one Newton step (relative error ~1e-7, the size of float rounding in
 // |d| itself): the divider (sqrt + div per batch) was the bottleneck.
-template <bool kTether>
+template <Kind kKind>
 void projectBatches(Vec4* x, const uint32_t* A, const uint32_t* B, const float* rest,
                     const float* inv_w, size_t m, float scale) {
 #if DRAPE_XPBD_SSE
@@ -99,7 +105,7 @@ void projectBatches(Vec4* x, const uint32_t* A, const uint32_t* B, const float* 
     y = _mm_mul_ps(_mm_mul_ps(half, y), _mm_sub_ps(three, _mm_mul_ps(len2, _mm_mul_ps(y, y))));
     const __m128 r = _mm_loadu_ps(rest + k);
     __m128 s;
-    if (kTether) {
+    if (kKind != Kind::Equality) {
       const __m128 c = _mm_max_ps(_mm_sub_ps(_mm_mul_ps(len2, y), _mm_mul_ps(r, vscale)), zero);
       s = _mm_mul_ps(_mm_mul_ps(c, y), _mm_loadu_ps(inv_w + k));
     } else {
@@ -111,7 +117,7 @@ void projectBatches(Vec4* x, const uint32_t* A, const uint32_t* B, const float* 
     ay = _mm_sub_ps(ay, _mm_mul_ps(sa, dy));
     az = _mm_sub_ps(az, _mm_mul_ps(sa, dz));
     scatter4(x, A + k, ax, ay, az, aw);
-    if (!kTether) {
+    if (kKind != Kind::Tether) {
       const __m128 sb = _mm_mul_ps(bw, s);
       bx = _mm_add_ps(bx, _mm_mul_ps(sb, dx));
       by = _mm_add_ps(by, _mm_mul_ps(sb, dy));
@@ -126,10 +132,10 @@ void projectBatches(Vec4* x, const uint32_t* A, const uint32_t* B, const float* 
     const Vec3 d = pa.head<3>() - pb.head<3>();
     const float len = std::sqrt(d.squaredNorm());
     if (!(len > 1e-9f)) continue;
-    const float c = kTether ? std::max(len - rest[k] * scale, 0.0f) : len - rest[k];
+    const float c = kKind != Kind::Equality ? std::max(len - rest[k] * scale, 0.0f) : len - rest[k];
     const float s = c / len * inv_w[k];
     pa.head<3>() -= (pa.w() * s) * d;
-    if (!kTether) pb.head<3>() += (pb.w() * s) * d;
+    if (kKind != Kind::Tether) pb.head<3>() += (pb.w() * s) * d;
   }
 #endif
 }
@@ -169,7 +175,7 @@ __attribute__((target("avx"))) inline void scatter8(Vec4* x, const uint32_t* off
   }
 }
 
-template <bool kTether>
+template <Kind kKind>
 __attribute__((target("avx"))) void projectBatchesAvx(Vec4* x, const uint32_t* A, const uint32_t* B,
                                                       const float* rest, const float* inv_w,
                                                       size_t m, float scale) {
@@ -190,15 +196,15 @@ __attribute__((target("avx"))) void projectBatchesAvx(Vec4* x, const uint32_t* A
                       _mm256_sub_ps(three, _mm256_mul_ps(len2, _mm256_mul_ps(y, y))));
     const __m256 r = _mm256_loadu_ps(rest + k);
     __m256 s;
-    if (kTether) {
+    if (kKind != Kind::Equality) {
       const __m256 c = _mm256_max_ps(_mm256_sub_ps(_mm256_mul_ps(len2, y), _mm256_mul_ps(r, vscale)), zero);
       s = _mm256_mul_ps(_mm256_mul_ps(c, y), _mm256_loadu_ps(inv_w + k));
     } else {
       s = _mm256_mul_ps(_mm256_sub_ps(one, _mm256_mul_ps(r, y)), _mm256_loadu_ps(inv_w + k));
     }
     s = _mm256_and_ps(ok, s);
-    if (kTether) {
-      // Most tethers are slack (inactive inequalities): when every lane's correction is zero and
+    if (kKind != Kind::Equality) {
+      // Most tethers (and nearly every edge against the strain limit) are slack (inactive inequalities): when every lane's correction is zero and
       // its d finite, the stores would write back what was read; skip them (same bits).
       const __m256 acts = _mm256_or_ps(_mm256_cmp_ps(s, zero, _CMP_NEQ_UQ), _mm256_cmp_ps(len2, inf, _CMP_NLT_UQ));
       if (_mm256_movemask_ps(acts) == 0) continue;
@@ -208,7 +214,7 @@ __attribute__((target("avx"))) void projectBatchesAvx(Vec4* x, const uint32_t* A
     ay = _mm256_sub_ps(ay, _mm256_mul_ps(sa, dy));
     az = _mm256_sub_ps(az, _mm256_mul_ps(sa, dz));
     scatter8(x, A + k, ax, ay, az, aw);
-    if (!kTether) {
+    if (kKind != Kind::Tether) {
       const __m256 sb = _mm256_mul_ps(bw, s);
       bx = _mm256_add_ps(bx, _mm256_mul_ps(sb, dx));
       by = _mm256_add_ps(by, _mm256_mul_ps(sb, dy));
@@ -221,17 +227,20 @@ __attribute__((target("avx"))) void projectBatchesAvx(Vec4* x, const uint32_t* A
 
 // A, B: particle indices; A_off, B_off: the same as byte offsets (empty when they would not fit
 // 32 bits: then the SSE kernel).
-template <bool kTether>
+// Entries [first, end) of the lists (first a multiple of the batch width: a colour group's start).
+template <Kind kKind>
 void project(Vec4* x, const std::vector<uint32_t>& A, const std::vector<uint32_t>& B,
              const std::vector<uint32_t>& A_off, const std::vector<uint32_t>& B_off, const float* rest,
-             const float* inv_w, float scale) {
+             const float* inv_w, float scale, size_t first = 0) {
   const size_t m = A.size();
+  if (first >= m) return;
 #if DRAPE_XPBD_AVX
   if (cpuHasAvx() && A_off.size() == m && B_off.size() == m)
-    return projectBatchesAvx<kTether>(x, A_off.data(), B_off.data(), rest, inv_w, m, scale);
+    return projectBatchesAvx<kKind>(x, A_off.data() + first, B_off.data() + first, rest + first,
+                                    inv_w + first, m - first, scale);
 #endif
   (void)A_off, (void)B_off;
-  projectBatches<kTether>(x, A.data(), B.data(), rest, inv_w, m, scale);
+  projectBatches<kKind>(x, A.data() + first, B.data() + first, rest + first, inv_w + first, m - first, scale);
 }
 
 #if DRAPE_XPBD_AVX
@@ -345,6 +354,7 @@ void XpbdSolver::buildBatches() {
   // them (only the tethers, inequalities that act on few particles, come after).
   const DistanceConstraints* kinds[3] = {&topology_.stretch, &topology_.shear, &topology_.bend};
   for (uint8_t k : kDistanceKindOrder) {
+    if (k == 0) stretch_first_ = distance_.a.size();  // where the stretch colour groups start
     appendPadded(*kinds[k], 0.0f, dummy, &distance_kind_, k, distance_.a, distance_.b,
                  distance_.rest, distance_.compliance, distance_.group_offsets);
   }
@@ -427,6 +437,14 @@ bool XpbdSolver::setParams(const XpbdParams& p, std::string& error) {
   }
   if (p.iterations < 1 || p.iterations > 64) {
     error = "iterations must be in [1, 64]";
+    return false;
+  }
+  if (!finite(p.strain_limit) || p.strain_limit < 0.0f || p.strain_limit > 10.0f) {
+    error = "strain_limit must be in [0, 10] (0 = off)";
+    return false;
+  }
+  if (p.strain_limit_passes < 1 || p.strain_limit_passes > 16) {
+    error = "strain_limit_passes must be in [1, 16]";
     return false;
   }
   params_ = p;
@@ -579,10 +597,18 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
     }
   }
   for (int it = 0; it < p.iterations; ++it) {  // 1 by default: the method's single pass
-    project<false>(x, distance_.a, distance_.b, distance_.a_off, distance_.b_off, distance_.rest.data(),
+    project<Kind::Equality>(x, distance_.a, distance_.b, distance_.a_off, distance_.b_off, distance_.rest.data(),
                    distance_.inv_w.data(), 1.0f);
-    project<true>(x, tethers_.a, tethers_.b, tethers_.a_off, tethers_.b_off, tethers_.rest.data(),
+    project<Kind::Tether>(x, tethers_.a, tethers_.b, tethers_.a_off, tethers_.b_off, tethers_.rest.data(),
                   tethers_.inv_w.data(), p.tether_scale);
+  }
+  // The strain limit (XpbdParams::strain_limit) on the step's last substep, before collision so
+  // that no particle is left inside an ellipsoid.
+  static_assert(kDistanceKindOrder[2] == 0, "the strain limit's passes run from the stretch groups to the end");
+  if (!predict_next && p.strain_limit > 0.0f) {
+    for (int pass = 0; pass < p.strain_limit_passes; ++pass)
+      project<Kind::Limit>(x, distance_.a, distance_.b, distance_.a_off, distance_.b_off, distance_.rest.data(),
+                           distance_.inv_w.data(), 1.0f + p.strain_limit, stretch_first_);
   }
   // 3. Collision against the tracking ellipsoids.
   if (collider != nullptr) {

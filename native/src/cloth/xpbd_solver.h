@@ -43,6 +43,17 @@ struct XpbdParams {
   // the converged reference. Multipliers restart at zero every pass (none are stored), so a
   // compliant constraint comes out a little stiffer with more passes; rigid ones are unaffected.
   int iterations = 1;
+  // Strain limit at the end of a step (Provot 1995's limit on over-stretched springs, applied to
+  // positions): in the step's last substep, after the constraint passes and before collision,
+  // `strain_limit_passes` Gauss–Seidel passes over the structural (stretch) edges pull every edge
+  // longer than rest * (1 + strain_limit) back to that length; shorter edges are left alone. The
+  // step's output is what the host draws: one substep's pass leaves a long chain of edges
+  // stretched by g h^2 N / L (docs/garments.md), and the limit takes the excess out of the pose
+  // shown at the cost of a few cheap passes (edges under the limit skip their stores), where more
+  // substeps or passes would cost every substep. The correction becomes velocity like any other.
+  // 0 = off (the solver's default; garments use 0.10, GarmentSimParams). [0, 10].
+  float strain_limit = 0.0f;
+  int strain_limit_passes = 2;  // [1, 16]
 };
 
 // Wall-clock split of the last step (only measured when enabled, for benchmarks): constraints =
@@ -162,6 +173,7 @@ class XpbdSolver {
   Batches distance_, tethers_;
   float inv_w_h2_ = -1.0f;  // the 1/h^2 that Batches::inv_w was computed for
   std::vector<uint8_t> distance_kind_;  // 0 stretch, 1 shear, 2 bend (3 padding), per entry
+  size_t stretch_first_ = 0;            // where the stretch colour groups start in distance_
   std::vector<Eigen::Vector4f> x_, prev_, v_;  // n + 1 entries: x_[n] is the dummy particle
   std::vector<Eigen::Vector4f> span_start_;     // positions where the current collision span began
   std::vector<Vec3> pin_start_, pin_target_;

@@ -134,14 +134,35 @@ cl_int ClPhaseKernels::enqueue(ClRuntime& runtime, const ClPhaseBuffers& b, cons
   arg(project_rows_, 8, static_cast<cl_uint>(distance));
   // The colour groups' launches, the same every pass and substep: (first group, count), a count
   // above 1 a run of consecutive small groups (rows 2 + c) for one launch of one work-group.
-  group_runs_.clear();
-  for (uint32_t c = 0; c < distance + tether;) {
-    uint32_t run = 0;
-    while (c + run < distance + tether && plan.maxItems(2 + c + run) <= wg) ++run;
-    run = run >= 2 ? run : 1;
-    group_runs_.emplace_back(c, run);
-    c += run;
-  }
+  auto makeRuns = [&](std::vector<std::pair<uint32_t, uint32_t>>& runs, uint32_t from, uint32_t to) {
+    runs.clear();
+    for (uint32_t c = from; c < to;) {
+      uint32_t run = 0;
+      while (c + run < to && plan.maxItems(2 + c + run) <= wg) ++run;
+      run = run >= 2 ? run : 1;
+      runs.emplace_back(c, run);
+      c += run;
+    }
+  };
+  makeRuns(group_runs_, 0, distance + tether);
+  // The groups' launches of one pass: distance groups, then tether groups (mode 1); with `limit`
+  // the strain limit's pass over the runs given (distance groups only, project_rows_ arg 11).
+  auto launchRuns = [&](const std::vector<std::pair<uint32_t, uint32_t>>& runs, bool limit) {
+    for (const auto& [c, run] : runs) {
+      if (run > 1) {
+        arg(project_rows_, 6, static_cast<cl_uint>(2 + c));
+        arg(project_rows_, 7, static_cast<cl_uint>(run));
+        launch(project_rows_, wg, false, true);
+        continue;
+      }
+      const bool is_tether = c >= distance;
+      arg(project_, 6, static_cast<cl_uint>(2 + c));
+      arg(project_, 7, static_cast<cl_uint>(is_tether ? c - distance : c));
+      arg(project_, 8, static_cast<cl_uint>(limit ? DCL_MODE_LIMIT : is_tether ? DCL_MODE_TETHER : DCL_MODE_DISTANCE));
+      launch(project_, plan.items(2 + c), false);
+    }
+  };
+  arg(project_rows_, 11, cl_uint{0});
   for (int s = 0; s < substeps; ++s) {
     const cl_int sub = s;
     arg(predict_, 7, sub);
@@ -153,19 +174,28 @@ cl_int ClPhaseKernels::enqueue(ClRuntime& runtime, const ClPhaseBuffers& b, cons
     for (int it = 0; it < iterations; ++it) {
       arg(project_, 10, static_cast<cl_int>(it));
       arg(project_rows_, 10, static_cast<cl_int>(it));
-      for (const auto& [c, run] : group_runs_) {
-        if (run > 1) {
-          arg(project_rows_, 6, static_cast<cl_uint>(2 + c));
-          arg(project_rows_, 7, static_cast<cl_uint>(run));
-          launch(project_rows_, wg, false, true);
-          continue;
-        }
-        const bool is_tether = c >= distance;
-        arg(project_, 6, static_cast<cl_uint>(2 + c));
-        arg(project_, 7, static_cast<cl_uint>(is_tether ? c - distance : c));
-        arg(project_, 8, static_cast<cl_uint>(is_tether ? 1 : 0));
-        launch(project_, plan.items(2 + c), false);
+      launchRuns(group_runs_, false);
+    }
+    // The strain limit (XpbdParams::strain_limit) after the passes of a substep that is some
+    // garment's last, before its collision: up to the most passes among those garments, over the
+    // distance groups from the first of their stretch groups (kind_end[1]); the kernels pick, per
+    // garment, its own last substep, passes and stretch groups (dcl_projects, phases.cl).
+    int limit_passes = 0;
+    uint32_t stretch_first = distance;
+    for (size_t g = 0; g < plan.garments(); ++g) {
+      if (work[g + 1] == work[g] || table[g].substeps != s + 1 || table[g].strain_passes <= 0) continue;
+      limit_passes = std::max(limit_passes, table[g].strain_passes);
+      stretch_first = std::min(stretch_first, table[g].kind_end[1]);
+    }
+    if (limit_passes > 0 && stretch_first < distance) {
+      makeRuns(limit_runs_, stretch_first, distance);
+      arg(project_rows_, 11, cl_uint{1});
+      for (int pass = 0; pass < limit_passes; ++pass) {
+        arg(project_, 10, static_cast<cl_int>(pass));
+        arg(project_rows_, 10, static_cast<cl_int>(pass));
+        launchRuns(limit_runs_, true);
       }
+      arg(project_rows_, 11, cl_uint{0});
     }
     arg(collide_velocity_, 11, sub);
     launch(collide_velocity_, plan.items(0), s + 1 == substeps);

@@ -65,7 +65,8 @@ class ClPhaseKernels {
   // Queues the frame of every per-phase garment of `table` (plan.garments() entries, the same
   // as on the device in b.table), without waiting. Consecutive colour groups of at most a
   // work-group's items (per garment) run in one launch of one work-group
-  // (drape_phase_project_rows). Substeps and passes run up to the largest of those garments'.
+  // (drape_phase_project_rows). Substeps and passes run up to the largest of those garments'; the
+  // strain limit's passes after each substep that is the last of some garment with it on.
   // first/last (optional): events of the first and the last launch (the kernel time), which the
   // caller releases. CL_SUCCESS or the failing call's code.
   cl_int enqueue(ClRuntime& runtime, const ClPhaseBuffers& b, const ClPhasePlan& plan,
@@ -74,7 +75,9 @@ class ClPhaseKernels {
  private:
   cl_kernel clear_stats_ = nullptr, pin_start_ = nullptr, predict_ = nullptr, pins_ = nullptr, project_ = nullptr,
             project_rows_ = nullptr, collide_velocity_ = nullptr;
-  std::vector<std::pair<uint32_t, uint32_t>> group_runs_;  // enqueue()'s scratch, kept between frames
+  // enqueue()'s scratch, kept between frames: the colour groups' launches of a regular pass and
+  // of a strain-limit pass.
+  std::vector<std::pair<uint32_t, uint32_t>> group_runs_, limit_runs_;
 };
 
 }  // namespace drape

@@ -123,22 +123,26 @@ bool clCollide(ClRuntime& rt, const std::vector<DrapeClShape>& shapes, const std
 }
 
 bool clProjectGroup(ClRuntime& rt, const std::vector<DrapeClConstraint>& constraints, uint32_t begin, uint32_t end,
-                    bool tether, float tether_scale, float alpha, std::vector<DclF4>& x, std::string& err,
+                    uint32_t mode, float scale, float alpha, std::vector<DclF4>& x, std::string& err,
                     ClStageTimes* times) {
   if (begin > end || end > constraints.size()) {
     err = "clProjectGroup: bad range";
     return false;
   }
+  if (mode > DCL_MODE_LIMIT) {
+    err = "clProjectGroup: bad mode";
+    return false;
+  }
   Launch l(rt, "drape_project_group", err);
   const cl_mem xb = l.buffer(x.data(), x.size() * 16);
   const cl_mem cb = l.buffer(constraints.data(), constraints.size() * sizeof(DrapeClConstraint));
-  const cl_uint t = tether ? 1u : 0u;
+  const cl_uint m = mode;
   l.arg(0, xb);
   l.arg(1, cb);
   l.arg(2, static_cast<cl_uint>(begin));
   l.arg(3, static_cast<cl_uint>(end));
-  l.arg(4, t);
-  l.arg(5, tether_scale);
+  l.arg(4, m);
+  l.arg(5, scale);
   l.arg(6, alpha);
   l.run(end - begin);
   l.read(xb, x.data(), x.size() * 16);

@@ -25,10 +25,12 @@ bool clCollide(ClRuntime& rt, const std::vector<DrapeClShape>& shapes, const std
                const std::vector<DclF4>& prev, CollisionStats& stats, std::string& err,
                ClStageTimes* times = nullptr);
 
-// One colour group: constraints [begin, end) of `constraints` projected on x (tether: one-sided
-// with `tether_scale`), each with inv_w = 1 / (w_sum + alpha), alpha = compliance / h^2.
+// One colour group: constraints [begin, end) of `constraints` projected on x by `mode`
+// (DCL_MODE_*: 0 distance; 1 tether, one-sided |d| <= rest * scale; 2 strain limit, the same
+// inequality on both ends; a bool `tether` reads as 0 / 1), each with inv_w = 1 / (w_sum + alpha),
+// alpha = compliance / h^2.
 bool clProjectGroup(ClRuntime& rt, const std::vector<DrapeClConstraint>& constraints, uint32_t begin, uint32_t end,
-                    bool tether, float tether_scale, float alpha, std::vector<DclF4>& x, std::string& err,
+                    uint32_t mode, float scale, float alpha, std::vector<DclF4>& x, std::string& err,
                     ClStageTimes* times = nullptr);
 
 // Area-weighted unit vertex normals of x for the triangle list `indices` (vertexNormals).

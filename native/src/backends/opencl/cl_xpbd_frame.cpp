@@ -131,6 +131,10 @@ bool ClXpbdSolver::prepareFrame(float dt, int substeps) {
   g.max_speed2 = p.max_speed > 0.0f ? p.max_speed * p.max_speed : 0.0f;
   g.velocity_scale = std::exp(-p.damping * h) / h;
   g.tether_scale = p.tether_scale;
+  // The strain limit's passes over the stretch groups in the frame's last substep (0: off, as
+  // XpbdSolver::substep skips them), each edge held to rest * (1 + strain_limit).
+  g.strain_passes = p.strain_limit > 0.0f ? p.strain_limit_passes : 0;
+  g.strain_scale = 1.0f + p.strain_limit;
   // The collider clamps friction to [0, 1e6] (NaN -> 0).
   g.static_friction = cp.static_friction > 0.0f ? std::min(cp.static_friction, 1e6f) : 0.0f;
   g.kinetic_friction = cp.kinetic_friction > 0.0f ? std::min(cp.kinetic_friction, 1e6f) : 0.0f;

@@ -1,0 +1,185 @@
+// The strain limit at the end of a step (XpbdParams::strain_limit, drape_cloth_params.strain_limit):
+// it holds the step's output to the limit where one pass per substep cannot, it leaves edges under
+// the limit untouched (a limit that never binds changes no bit), the range is enforced and a
+// rejected value changes nothing, the C ABI's default is 0.1 and round-trips, and on a real take it
+// lowers the garment's stretch with no particle left inside an ellipsoid (docs/garments.md, "A
+// strain limit at the end of each step").
+#include "capi_test_support.h"
+#include "cloth/cloth_stats.h"
+#include "cloth/xpbd_solver.h"
+#include "garment_scene.h"
+#include "test_data.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+namespace drape {
+namespace {
+
+// 20 x 20 particles, a 1 m square hanging from its top row, no tethers, 2 substeps per 1/60 s:
+// one pass per substep leaves the top of its columns stretched by about g h^2 N / L = 9.81 x
+// (1/120)^2 x 19 / (1/19) = 24 % (docs/garments.md), the hanging side panel of a shirt.
+GarmentTopology limitSquare() {
+  std::vector<float> positions;
+  std::vector<uint32_t> indices;
+  makeClothGrid(20, 20, 1.0f, 1.0f, Vec3::Zero(), Vec3::UnitX(), Vec3(-Vec3::UnitY()), positions, indices);
+  TopologyParams p;
+  p.area_density = 0.2f;
+  for (uint32_t i = 0; i < 20; ++i) p.pinned.push_back(i);
+  p.max_tethers_per_particle = 0;
+  GarmentTopology t;
+  std::string error;
+  EXPECT_TRUE(buildGarmentTopology(positions.data(), positions.size() / 3, indices.data(), indices.size(), p, t,
+                                   error))
+      << error;
+  return t;
+}
+
+// One simulated second; the worst frame's max and P99 structural stretch.
+struct LimitRun {
+  float max = 0.0f, p99 = 0.0f;
+  std::vector<Eigen::Vector4f> x;
+};
+LimitRun runSquare(float limit, int passes = 2) {
+  XpbdSolver s(limitSquare());
+  XpbdParams p;
+  p.strain_limit = limit;
+  p.strain_limit_passes = passes;
+  std::string error;
+  EXPECT_TRUE(s.setParams(p, error)) << error;
+  LimitRun r;
+  std::vector<float> scratch;
+  for (int f = 0; f < 60; ++f) {
+    EXPECT_TRUE(s.step(1.0f / 60.0f, 2));
+    const StretchStats st = stretchStats(s.topology(), s.positions(), scratch);
+    r.max = std::max(r.max, st.max);
+    r.p99 = std::max(r.p99, st.p99);
+  }
+  r.x.assign(s.positions(), s.positions() + s.particleCount());
+  return r;
+}
+
+TEST(StrainLimit, HoldsTheStepsOutputNearTheLimit) {
+  const LimitRun off = runSquare(0.0f);
+  const LimitRun on = runSquare(0.02f);
+  const LimitRun more = runSquare(0.02f, 8);
+  const LimitRun near = runSquare(0.2f, 8);
+  std::printf("[ figures  ] worst frame max / P99 stretch: off %.4f / %.4f, limit 0.02 x 2 passes %.4f / %.4f, "
+              "x 8 passes %.4f / %.4f; limit 0.2 x 8 passes %.4f / %.4f\n",
+              off.max, off.p99, on.max, on.p99, more.max, more.p99, near.max, near.p99);
+  ASSERT_GT(off.max, 0.25f);  // the scene needs the limit
+  // Each pass is one Gauss-Seidel sweep: a 19-edge column over the limit needs many, so the
+  // output comes down pass by pass towards the limit...
+  EXPECT_LT(on.max, 0.85f * off.max);
+  EXPECT_LT(on.p99, 0.8f * off.p99);
+  EXPECT_LT(more.max, 0.6f * off.max);
+  EXPECT_LT(more.p99, 0.75f * on.p99);
+  // ...and where only the top edges of each column are over it, a few passes hold it.
+  EXPECT_LT(near.max, 0.2f + 0.01f);
+}
+
+TEST(StrainLimit, AnEdgeUnderTheLimitIsNotTouched) {
+  // A limit no edge reaches runs its passes and must change no bit of the result.
+  const LimitRun off = runSquare(0.0f);
+  const LimitRun slack = runSquare(10.0f, 16);
+  ASSERT_EQ(off.x.size(), slack.x.size());
+  EXPECT_EQ(std::memcmp(off.x.data(), slack.x.data(), off.x.size() * sizeof(off.x[0])), 0);
+}
+
+TEST(StrainLimit, RangeIsEnforcedAndARejectionChangesNothing) {
+  XpbdSolver s(limitSquare());
+  std::string error;
+  XpbdParams p;
+  p.strain_limit = 0.05f;
+  p.strain_limit_passes = 3;
+  ASSERT_TRUE(s.setParams(p, error)) << error;
+  for (float bad : {-0.01f, 10.5f, std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+    XpbdParams q = p;
+    q.strain_limit = bad;
+    error.clear();
+    EXPECT_FALSE(s.setParams(q, error)) << bad;
+    EXPECT_NE(error.find("strain_limit"), std::string::npos) << error;
+  }
+  for (int bad : {0, -1, 17}) {
+    XpbdParams q = p;
+    q.strain_limit_passes = bad;
+    error.clear();
+    EXPECT_FALSE(s.setParams(q, error)) << bad;
+    EXPECT_NE(error.find("strain_limit_passes"), std::string::npos) << error;
+  }
+  EXPECT_EQ(s.params().strain_limit, 0.05f);
+  EXPECT_EQ(s.params().strain_limit_passes, 3);
+  EXPECT_EQ(XpbdParams{}.strain_limit, 0.0f);          // the bare solver: off
+  EXPECT_EQ(GarmentSimParams{}.xpbd.strain_limit, 0.1f);  // garments: 10 %
+}
+
+// The default T-shirt (1 000 particles) on Ges01, with the limit (the default) and without: the
+// median per-frame P99 stretch falls, nothing is left inside an ellipsoid, no NaN.
+TEST(StrainLimit, LowersAGarmentsStretchOnARealTake) {
+  DRAPE_REQUIRE_SHARED(path, "kinect_v2_msft_labanotation/Ges01_wavehand.csv");
+  test::SceneSummary with, without;
+  for (float limit : {0.1f, 0.0f}) {
+    Recording rec;
+    std::string err;
+    Context ctx(test::defaultDesc());
+    ASSERT_TRUE(readRecordingFile(path, 0, rec, err)) << err;
+    GarmentSimParams params;
+    params.xpbd.strain_limit = limit;
+    GarmentSim* g = test::addTemplate(ctx, GarmentKind::TShirt, 1000, ClothSolverKind::Xpbd, params, err);
+    ASSERT_NE(g, nullptr) << err;
+    (limit > 0.0f ? with : without) = test::replay(ctx, *g, rec, err, /*measure_body=*/false);
+    ASSERT_EQ((limit > 0.0f ? with : without).frames, static_cast<int>(rec.frames.size())) << err;
+  }
+  std::printf("[ figures  ] Ges01 T-shirt, 1 000 particles: median per-frame P99 stretch %.4f with the limit, "
+              "%.4f without; worst frame %.4f / %.4f; inside %llu / %llu\n",
+              with.p99_stretch_median, without.p99_stretch_median, with.p99_stretch_worst, without.p99_stretch_worst,
+              static_cast<unsigned long long>(with.proxy_inside), static_cast<unsigned long long>(without.proxy_inside));
+  EXPECT_TRUE(with.finite);
+  EXPECT_EQ(with.nan_resets, 0);
+  EXPECT_EQ(with.proxy_inside, 0u);
+  // Most frames' P99 is under the limit already (the median moves little); the frames with the
+  // arm raised are where it acts.
+  EXPECT_LE(with.p99_stretch_median, without.p99_stretch_median + 0.002f);
+  EXPECT_LT(with.p99_stretch_worst, 0.95f * without.p99_stretch_worst);
+  EXPECT_LT(with.max_stretch, without.max_stretch);
+}
+
+}  // namespace
+}  // namespace drape
+
+namespace {
+
+TEST(CApiStrainLimit, DefaultIsATenthAndTheValueRoundTrips) {
+  drape_cloth_params c;
+  ASSERT_EQ(drape_cloth_params_init(&c), DRAPE_OK);
+  EXPECT_EQ(c.strain_limit, 0.1f);
+
+  drape_context* ctx = nullptr;
+  ASSERT_EQ(drape_context_create(nullptr, &ctx), DRAPE_OK) << lastError();
+  drape_garment_template t;
+  ASSERT_EQ(drape_garment_template_init(&t), DRAPE_OK);
+  t.particles = 500;
+  c.strain_limit = 0.0f;  // off, as the `reserved` field it replaced had to be
+  drape_garment* g = nullptr;
+  ASSERT_EQ(drape_context_add_garment_template(ctx, nullptr, &t, &c, &g), DRAPE_OK) << lastError();
+  drape_cloth_params back;
+  back.struct_size = sizeof(back);
+  ASSERT_EQ(drape_garment_get_params(g, &back), DRAPE_OK);
+  EXPECT_EQ(back.strain_limit, 0.0f);
+  back.strain_limit = 0.25f;
+  ASSERT_EQ(drape_garment_set_params(g, &back), DRAPE_OK) << lastError();
+  back.strain_limit = -1.0f;
+  EXPECT_EQ(drape_garment_set_params(g, &back), DRAPE_ERROR_OUT_OF_RANGE);
+  EXPECT_NE(lastError().find("strain_limit"), std::string::npos) << lastError();
+  drape_cloth_params still;
+  still.struct_size = sizeof(still);
+  ASSERT_EQ(drape_garment_get_params(g, &still), DRAPE_OK);
+  EXPECT_EQ(still.strain_limit, 0.25f);
+  EXPECT_EQ(drape_context_destroy(ctx), DRAPE_OK);
+}
+
+}  // namespace
