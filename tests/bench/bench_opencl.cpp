@@ -9,6 +9,7 @@
 //      --benchmark_report_aggregates_only=true
 #include "body/body_model.h"
 #include "body/body_shape.h"
+#include "cloth/garment_sim.h"
 #include "cloth/garment_templates.h"
 #include "cloth/garment_topology.h"
 #include "cloth/xpbd_solver.h"
@@ -46,11 +47,8 @@ Scene& scene(int target, benchmark::State& state) {
 constexpr int kSubsteps = 10;
 
 XpbdParams benchParams() {
-  XpbdParams p;
-  p.collision_stride = 2;  // the garment default (GarmentSimParams)
-  p.collision.max_escape_m = 0.01f;
-  p.tether_scale = 1.1f;
-  return p;
+  return GarmentSimParams{}.xpbd;  // the garment default: collision stride 2, 1 cm escape, tether
+                                   // slack 1.1, strain limit 0.1
 }
 
 // Drives any solver with the XpbdSolver interface (S::setColliderMotion differs: adapter F).

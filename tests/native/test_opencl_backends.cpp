@@ -288,7 +288,7 @@ TEST(OpenClParity, TShirtOnKinectTake) {
               kFrames, device.rms(), device.worst, device.last_rms, self.rms(), self.worst, self.last_rms);
   EXPECT_LT(device.rms(), 3.0 * self.rms() + 0.01);
   EXPECT_LT(device.worst, 3.0f * self.worst + 0.1f);
-  EXPECT_LT(device.rms(), 15.0);  // absolute: the measured 4.9 mm plus a margin
+  EXPECT_LT(device.rms(), 15.0);  // absolute: the measured 4.9 mm (5.1 with the strain limit) plus a margin
 }
 
 }  // namespace
