@@ -58,9 +58,15 @@ void DCL_FRAME_BODY(__global const DrapeClGarment* g, DCL_XS float4* x, __global
       x[p] = (float4)(a.xyz + pin_t * (b.xyz - a.xyz), x[p].w);
     }
     barrier(CLK_LOCAL_MEM_FENCE | CLK_GLOBAL_MEM_FENCE);
-    /* 2. Constraint passes: distance colour groups, then tethers (one-sided). */
-    for (int it = 0; it < g->iterations; ++it) {
-      for (uint c = 0; c < g->distance_groups; ++c) {
+    /* 2. Constraint passes: distance colour groups, then tethers (one-sided). In the frame's last
+     * substep, before collision, the strain limit's passes follow (XpbdParams::strain_limit):
+     * strain_passes passes over the stretch groups only (the last distance kind, from
+     * kind_end[1]), each edge longer than rest * strain_scale pulled back to it, both ends moving,
+     * and no tethers. `limit` is the same for the whole work-group. */
+    const int passes = g->iterations + (s + 1 == substeps ? g->strain_passes : 0);
+    for (int it = 0; it < passes; ++it) {
+      const bool limit = it >= g->iterations;
+      for (uint c = limit ? g->kind_end[1] : 0u; c < g->distance_groups; ++c) {
         const uint begin = groups[g->distance_group_offset + c];
         const uint end = groups[g->distance_group_offset + c + 1];
         const float alpha = dcl_group_alpha(g, c, 0u);
@@ -71,7 +77,9 @@ void DCL_FRAME_BODY(__global const DrapeClGarment* g, DCL_XS float4* x, __global
           const float len2 = dot(d, d);
           if (!(len2 > 1e-18f)) continue;
           const float y = rsqrt(len2);
-          const float sc = (1.0f - cst.rest * y) * dcl_inv_w(cst.w_sum, alpha);
+          const float inv_w = dcl_inv_w(cst.w_sum, alpha);
+          const float sc = limit ? fmax(len2 * y - cst.rest * g->strain_scale, 0.0f) * y * inv_w
+                                 : (1.0f - cst.rest * y) * inv_w;
           pa.xyz -= (pa.w * sc) * d;
           pb.xyz += (pb.w * sc) * d;
           x[cst.a] = pa;
@@ -79,7 +87,7 @@ void DCL_FRAME_BODY(__global const DrapeClGarment* g, DCL_XS float4* x, __global
         }
         barrier(CLK_LOCAL_MEM_FENCE | CLK_GLOBAL_MEM_FENCE);
       }
-      for (uint c = 0; c < g->tether_groups; ++c) {
+      for (uint c = 0; !limit && c < g->tether_groups; ++c) {
         const uint begin = groups[g->tether_group_offset + c];
         const uint end = groups[g->tether_group_offset + c + 1];
         const float alpha = g->alpha[3];
@@ -95,33 +103,6 @@ void DCL_FRAME_BODY(__global const DrapeClGarment* g, DCL_XS float4* x, __global
           x[cst.a] = pa;
         }
         barrier(CLK_LOCAL_MEM_FENCE | CLK_GLOBAL_MEM_FENCE);
-      }
-    }
-    /* The strain limit (XpbdParams::strain_limit) in the frame's last substep, before collision:
-     * strain_passes passes over the stretch groups (the last distance kind, from kind_end[1]),
-     * each edge longer than rest * strain_scale pulled back to it, both ends moving. */
-    if (s + 1 == substeps) {
-      for (int pass = 0; pass < g->strain_passes; ++pass) {
-        for (uint c = g->kind_end[1]; c < g->distance_groups; ++c) {
-          const uint begin = groups[g->distance_group_offset + c];
-          const uint end = groups[g->distance_group_offset + c + 1];
-          const float alpha = dcl_group_alpha(g, c, 0u);
-          for (uint k = begin + lid; k < end; k += lsize) {
-            const DrapeClConstraint cst = constraints[k];
-            float4 pa = x[cst.a], pb = x[cst.b];
-            const float3 d = pa.xyz - pb.xyz;
-            const float len2 = dot(d, d);
-            if (!(len2 > 1e-18f)) continue;
-            const float y = rsqrt(len2);
-            const float c_len = fmax(len2 * y - cst.rest * g->strain_scale, 0.0f);
-            const float sc = c_len * y * dcl_inv_w(cst.w_sum, alpha);
-            pa.xyz -= (pa.w * sc) * d;
-            pb.xyz += (pb.w * sc) * d;
-            x[cst.a] = pa;
-            x[cst.b] = pb;
-          }
-          barrier(CLK_LOCAL_MEM_FENCE | CLK_GLOBAL_MEM_FENCE);
-        }
       }
     }
     /* 3. Collision (this span's ellipsoids), 4. velocities from positions, damping, clamp. */

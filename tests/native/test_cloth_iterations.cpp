@@ -3,6 +3,7 @@
 // rejected value changes nothing, and the C ABI carries the value both ways. drape-bench prices
 // substeps against iterations (docs/benchmarks.md).
 #include "capi_test_support.h"
+#include "cloth_grid.h"
 #include "cloth/cloth_stats.h"
 #include "cloth/xpbd_solver.h"
 
@@ -18,19 +19,11 @@ namespace {
 // 20 x 20 particles, 1 m square hanging in the XY plane from its two top corners, no tethers:
 // with 2 substeps per 1/60 s frame one pass leaves clear stretch that more passes remove.
 GarmentTopology hangingSquare() {
-  std::vector<float> positions;
-  std::vector<uint32_t> indices;
-  makeClothGrid(20, 20, 1.0f, 1.0f, Vec3::Zero(), Vec3::UnitX(), Vec3(-Vec3::UnitY()), positions, indices);
   TopologyParams p;
   p.area_density = 0.2f;
   p.pinned = {0, 19};
   p.max_tethers_per_particle = 0;
-  GarmentTopology t;
-  std::string error;
-  EXPECT_TRUE(buildGarmentTopology(positions.data(), positions.size() / 3, indices.data(), indices.size(), p, t,
-                                   error))
-      << error;
-  return t;
+  return test::clothGridTopology(test::ClothGrid{}, p);
 }
 
 StretchStats stretchAfterOneSecond(int iterations) {

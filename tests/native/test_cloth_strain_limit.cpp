@@ -5,6 +5,7 @@
 // lowers the garment's stretch with no particle left inside an ellipsoid (docs/garments.md, "A
 // strain limit at the end of each step").
 #include "capi_test_support.h"
+#include "cloth_grid.h"
 #include "cloth/cloth_stats.h"
 #include "cloth/xpbd_solver.h"
 #include "garment_scene.h"
@@ -24,19 +25,11 @@ namespace {
 // one pass per substep leaves the top of its columns stretched by about g h^2 N / L = 9.81 x
 // (1/120)^2 x 19 / (1/19) = 24 % (docs/garments.md), the hanging side panel of a shirt.
 GarmentTopology limitSquare() {
-  std::vector<float> positions;
-  std::vector<uint32_t> indices;
-  makeClothGrid(20, 20, 1.0f, 1.0f, Vec3::Zero(), Vec3::UnitX(), Vec3(-Vec3::UnitY()), positions, indices);
   TopologyParams p;
   p.area_density = 0.2f;
   for (uint32_t i = 0; i < 20; ++i) p.pinned.push_back(i);
   p.max_tethers_per_particle = 0;
-  GarmentTopology t;
-  std::string error;
-  EXPECT_TRUE(buildGarmentTopology(positions.data(), positions.size() / 3, indices.data(), indices.size(), p, t,
-                                   error))
-      << error;
-  return t;
+  return test::clothGridTopology(test::ClothGrid{}, p);
 }
 
 // One simulated second; the worst frame's max and P99 structural stretch.

@@ -5,6 +5,7 @@
 // kernel against XpbdSolver::transform; plus the program's build log reaching the error and the
 // device choice failing cleanly. Tolerances: float rounding (the device may fuse multiply-adds
 // and uses its own rsqrt), stated per test.
+#include "cloth_grid.h"
 #include "opencl_test_support.h"
 
 #if DRAPE_HAVE_OPENCL
@@ -39,6 +40,18 @@ Ellipsoid makeEllipsoid(const Vec3& c, const Vec3& radii, float angle, const Vec
   e.rotation = Eigen::AngleAxisf(angle, axis.normalized()).toRotationMatrix();
   e.refresh();
   return e;
+}
+
+// A flat 1 m square of nx x nz particles in the XZ plane round the origin, pinned at the two
+// corners of its first row: what the frame tests drape over their ellipsoids.
+GarmentTopology flatSquare(int nx, int nz) {
+  test::ClothGrid g;
+  g.nx = nx, g.ny = nz;
+  g.origin = Vec3(-0.5f, 0.0f, -0.5f);
+  g.v = Vec3::UnitZ();
+  TopologyParams tp;
+  tp.pinned = {0, static_cast<uint32_t>(nx - 1)};
+  return test::clothGridTopology(g, tp);
 }
 
 // Overlapping, moving, rotated ellipsoids (a torso, an arm against it, a small flat one) and
@@ -337,14 +350,8 @@ constexpr float kStrainTestStretchCompliance = 1e-2f;
 // A third time with the strain limit on (XpbdParams::strain_limit, GarmentSimParams' 0.1, two
 // passes in each step's last substep): the same bounds.
 void frameMatchesXpbdStep(const std::shared_ptr<ClRuntime>& rt, bool varying, float strain_limit = 0.0f) {
-  std::vector<float> positions;
-  std::vector<uint32_t> indices;
-  makeClothGrid(24, 24, 1.0f, 1.0f, Vec3(-0.5f, 0.0f, -0.5f), Vec3::UnitX(), Vec3::UnitZ(), positions, indices);
-  TopologyParams tp;
-  tp.pinned = {0, 23};
-  GarmentTopology t;
+  const GarmentTopology t = flatSquare(24, 24);
   std::string err;
-  ASSERT_TRUE(buildGarmentTopology(positions.data(), positions.size() / 3, indices.data(), indices.size(), tp, t, err));
   XpbdParams p;
   p.collision_stride = 2;
   p.drag = 0.3f;
@@ -436,14 +443,8 @@ float maxStretch(const GarmentTopology& t, const Eigen::Vector4f* x) {
 // the positions differ and the largest strain is well above the limit's.
 TEST(OpenClKernels, StrainLimitMatchesCpuOnBothDevicePaths) {
   DRAPE_REQUIRE_OPENCL(rt);
-  std::vector<float> positions;
-  std::vector<uint32_t> indices;
-  makeClothGrid(24, 24, 1.0f, 1.0f, Vec3(-0.5f, 0.0f, -0.5f), Vec3::UnitX(), Vec3::UnitZ(), positions, indices);
-  TopologyParams tp;
-  tp.pinned = {0, 23};
-  GarmentTopology t;
+  const GarmentTopology t = flatSquare(24, 24);
   std::string err;
-  ASSERT_TRUE(buildGarmentTopology(positions.data(), positions.size() / 3, indices.data(), indices.size(), tp, t, err));
   float min_rest = 1e9f;
   for (float r : t.stretch.rest) min_rest = std::min(min_rest, r);
   XpbdParams on;
@@ -521,18 +522,7 @@ TEST(OpenClKernels, StrainLimitMatchesCpuOnBothDevicePaths) {
 // the kernel picks the garments), so the batch gives the bits of each garment stepped alone.
 TEST(OpenClKernels, BatchedPhasesRunEachGarmentsStrainLimitInItsOwnLastSubstep) {
   DRAPE_REQUIRE_OPENCL(rt);
-  auto grid = [](int nx, int nz, GarmentTopology& t) {
-    std::vector<float> positions;
-    std::vector<uint32_t> indices;
-    makeClothGrid(nx, nz, 1.0f, 1.0f, Vec3(-0.5f, 0.0f, -0.5f), Vec3::UnitX(), Vec3::UnitZ(), positions, indices);
-    TopologyParams tp;
-    tp.pinned = {0, static_cast<uint32_t>(nx - 1)};
-    std::string error;
-    return buildGarmentTopology(positions.data(), positions.size() / 3, indices.data(), indices.size(), tp, t, error);
-  };
-  GarmentTopology ta, tb;
-  ASSERT_TRUE(grid(24, 24, ta));
-  ASSERT_TRUE(grid(20, 30, tb));
+  const GarmentTopology ta = flatSquare(24, 24), tb = flatSquare(20, 30);
   struct Member {
     const GarmentTopology* t;
     float strain_limit;
@@ -588,14 +578,8 @@ namespace {
 // limit's passes too).
 TEST(OpenClKernels, PhaseLaunchesMatchTheWorkGroupFrameBitForBit) {
   DRAPE_REQUIRE_OPENCL(rt);
-  std::vector<float> positions;
-  std::vector<uint32_t> indices;
-  makeClothGrid(30, 30, 1.0f, 1.0f, Vec3(-0.5f, 0.0f, -0.5f), Vec3::UnitX(), Vec3::UnitZ(), positions, indices);
-  TopologyParams tp;
-  tp.pinned = {0, 29};
-  GarmentTopology t;
+  const GarmentTopology t = flatSquare(30, 30);
   std::string err;
-  ASSERT_TRUE(buildGarmentTopology(positions.data(), positions.size() / 3, indices.data(), indices.size(), tp, t, err));
   // Without and with the strain limit (its passes: one launch per stretch group there).
   for (const float strain_limit : {0.0f, 0.1f}) {
     SCOPED_TRACE(::testing::Message() << "strain_limit " << strain_limit);
