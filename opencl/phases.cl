@@ -119,7 +119,7 @@ __kernel void drape_phase_pins(__global const DrapeClGarment* table, uint count,
  * iterations; the strain limit's (limit = 1) only in its own last substep, up to its
  * strain_passes (0 when off), and only over its stretch groups (from kind_end[1]). */
 bool dcl_projects(__global const DrapeClGarment* g, uint group, uint tether, uint limit, int substep,
-                         int pass) {
+                  int pass) {
   if (limit) return substep + 1 == g->substeps && pass < g->strain_passes && !tether && group >= g->kind_end[1];
   return substep < g->substeps && pass < g->iterations;
 }

@@ -204,8 +204,9 @@ __attribute__((target("avx"))) void projectBatchesAvx(Vec4* x, const uint32_t* A
     }
     s = _mm256_and_ps(ok, s);
     if (kKind != Kind::Equality) {
-      // Most tethers (and nearly every edge against the strain limit) are slack (inactive inequalities): when every lane's correction is zero and
-      // its d finite, the stores would write back what was read; skip them (same bits).
+      // Most tethers, and nearly every edge against the strain limit, are slack (inactive
+      // inequalities): when every lane's correction is zero and its d finite, the stores would
+      // write back what was read; skip them (same bits).
       const __m256 acts = _mm256_or_ps(_mm256_cmp_ps(s, zero, _CMP_NEQ_UQ), _mm256_cmp_ps(len2, inf, _CMP_NLT_UQ));
       if (_mm256_movemask_ps(acts) == 0) continue;
     }
@@ -597,10 +598,10 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
     }
   }
   for (int it = 0; it < p.iterations; ++it) {  // 1 by default: the method's single pass
-    project<Kind::Equality>(x, distance_.a, distance_.b, distance_.a_off, distance_.b_off, distance_.rest.data(),
-                   distance_.inv_w.data(), 1.0f);
+    project<Kind::Equality>(x, distance_.a, distance_.b, distance_.a_off, distance_.b_off,
+                            distance_.rest.data(), distance_.inv_w.data(), 1.0f);
     project<Kind::Tether>(x, tethers_.a, tethers_.b, tethers_.a_off, tethers_.b_off, tethers_.rest.data(),
-                  tethers_.inv_w.data(), p.tether_scale);
+                          tethers_.inv_w.data(), p.tether_scale);
   }
   // The strain limit (XpbdParams::strain_limit) on the step's last substep, before collision so
   // that no particle is left inside an ellipsoid.
