@@ -56,7 +56,8 @@ function(check_csv path first_numeric)
 endfunction()
 
 find_program(_gnuplot gnuplot)
-foreach(sweep solver substeps iterations ring_points contact_response continuous_collision resolution backend)
+foreach(sweep solver substeps iterations strain_limit ring_points contact_response continuous_collision resolution
+        backend)
   check_csv("${OUT_DIR}/${sweep}.csv" 6)
   if(_gnuplot)
     if(NOT EXISTS "${OUT_DIR}/${sweep}.png")

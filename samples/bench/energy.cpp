@@ -77,6 +77,7 @@ bool energyDrift(const Setting& s, double seconds, EnergyDrift& out, std::string
   p.drag = 0.0f;
   p.max_speed = 0.0f;
   p.iterations = static_cast<int>(s.iterations);
+  p.strain_limit = s.strain_limit;
   drape::XpbdSolver solver(t);
   if (!solver.setParams(p, error)) return false;
   return run(solver, g, frames, substeps, scale, out);

@@ -27,8 +27,8 @@ void markDefaults(Sweep& sw) {
 }  // namespace
 
 std::vector<std::string> sweepNames() {
-  return {"solver",     "substeps", "iterations", "ring_points", "contact_response", "continuous_collision",
-          "resolution", "backend"};
+  return {"solver",           "substeps",          "iterations", "strain_limit", "ring_points",
+          "contact_response", "continuous_collision", "resolution", "backend"};
 }
 
 std::vector<Sweep> makeSweeps(bool quick, bool with_opencl) {
@@ -64,6 +64,20 @@ std::vector<Sweep> makeSweeps(bool quick, bool with_opencl) {
         s.iterations = it;
         sw.settings.push_back(s);
       }
+    }
+    out.push_back(sw);
+  }
+  {
+    // drape_cloth_params.strain_limit: structural edges held to rest x (1 + limit) at the end of
+    // each step (docs/cloth-solver.md).
+    Sweep sw{"strain_limit", "Strain limit at the end of each step (structural edges, over rest)", {}};
+    const std::vector<float> limits = quick ? std::vector<float>{0.0f, 0.1f} : std::vector<float>{0.0f, 0.05f, 0.1f, 0.2f};
+    for (float l : limits) {
+      char label[32];
+      std::snprintf(label, sizeof label, l > 0.0f ? "%g %%" : "off", 100.0 * l);
+      Setting s = base("strain_limit", label);
+      s.strain_limit = l;
+      sw.settings.push_back(s);
     }
     out.push_back(sw);
   }

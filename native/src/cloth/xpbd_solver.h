@@ -49,8 +49,8 @@ struct XpbdParams {
   // longer than rest * (1 + strain_limit) back to that length; shorter edges are left alone. The
   // step's output is what the host draws: one substep's pass leaves a long chain of edges
   // stretched by g h^2 N / L (docs/garments.md), and the limit takes the excess out of the pose
-  // shown at the cost of a few cheap passes (edges under the limit skip their stores), where more
-  // substeps or passes would cost every substep. The correction becomes velocity like any other.
+  // shown at the cost of two passes in one substep (edges under the limit skip their stores),
+  // where more substeps or passes would cost every substep. The correction becomes velocity.
   // 0 = off (the solver's default; garments use 0.10, GarmentSimParams). [0, 10].
   float strain_limit = 0.0f;
   int strain_limit_passes = 2;  // [1, 16]
