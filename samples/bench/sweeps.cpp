@@ -27,8 +27,8 @@ void markDefaults(Sweep& sw) {
 }  // namespace
 
 std::vector<std::string> sweepNames() {
-  return {"solver",           "substeps",          "iterations", "strain_limit", "ring_points",
-          "contact_response", "continuous_collision", "resolution", "backend"};
+  return {"solver", "substeps", "iterations", "strain_limit", "ring_points", "contact_response",
+          "continuous_collision", "resolution", "backend"};
 }
 
 std::vector<Sweep> makeSweeps(bool quick, bool with_opencl) {
