@@ -198,18 +198,18 @@ __attribute__((target("avx"))) void projectBatchesAvx(Vec4* x, const uint32_t* A
     __m256 s;
     if (kKind != Kind::Equality) {
       const __m256 c = _mm256_max_ps(_mm256_sub_ps(_mm256_mul_ps(len2, y), _mm256_mul_ps(r, vscale)), zero);
+      // Most tethers, and nearly every edge against the strain limit, are slack (inactive
+      // inequalities): when every lane's violation is zero and its d finite, the stores would
+      // write back what was read; skip them (same bits), before inv_w is read. A lane whose
+      // correction comes out zero anyway (inv_w 0: both ends pinned) writes back its own bits.
+      const __m256 acts = _mm256_or_ps(_mm256_cmp_ps(_mm256_and_ps(ok, c), zero, _CMP_NEQ_UQ),
+                                       _mm256_cmp_ps(len2, inf, _CMP_NLT_UQ));
+      if (_mm256_movemask_ps(acts) == 0) continue;
       s = _mm256_mul_ps(_mm256_mul_ps(c, y), _mm256_loadu_ps(inv_w + k));
     } else {
       s = _mm256_mul_ps(_mm256_sub_ps(one, _mm256_mul_ps(r, y)), _mm256_loadu_ps(inv_w + k));
     }
     s = _mm256_and_ps(ok, s);
-    if (kKind != Kind::Equality) {
-      // Most tethers, and nearly every edge against the strain limit, are slack (inactive
-      // inequalities): when every lane's correction is zero and its d finite, the stores would
-      // write back what was read; skip them (same bits).
-      const __m256 acts = _mm256_or_ps(_mm256_cmp_ps(s, zero, _CMP_NEQ_UQ), _mm256_cmp_ps(len2, inf, _CMP_NLT_UQ));
-      if (_mm256_movemask_ps(acts) == 0) continue;
-    }
     const __m256 sa = _mm256_mul_ps(aw, s);
     ax = _mm256_sub_ps(ax, _mm256_mul_ps(sa, dx));
     ay = _mm256_sub_ps(ay, _mm256_mul_ps(sa, dy));
