@@ -144,11 +144,11 @@ typedef enum drape_garment_fit {
   DRAPE_GARMENT_FIT_SHAPE = 0,
   /* The tracked person's. Until the tracker has calibrated the bone lengths (calibration_frames),
    * garments are cut for the shape's standard proportions; then every garment cut for the skeleton
-   * is cut again for this person: the rest pose takes their bone lengths and their torso's geometry (spine, hip and
-   * shoulder joints) averaged over the calibration window, template garments are made again on it
-   * with their first layout, OBJ garments carried to it (drape_garment_stats.refits counts it;
-   * particles and triangles stay, the rest shape changes). No refit when the person's rest pose is
-   * within 1 cm of the standard one. Less stretch on most shared takes at 2 000 particles, more on
+   * is cut again for this person: the rest pose takes their bone lengths and their torso's
+   * geometry (spine, hip and shoulder joints) averaged over the calibration window, template
+   * garments are made again on it with their first layout, OBJ garments carried to it
+   * (drape_garment_stats.refits counts it; particles and triangles stay, the rest shape changes).
+   * No refit when the person's rest pose is within 1 cm of the standard one. Less stretch on most shared takes at 2 000 particles, more on
    * some (skirts on the Kinect takes, coarse garments): docs/garments.md. */
   DRAPE_GARMENT_FIT_SKELETON = 1,
   DRAPE_GARMENT_FIT_FORCE32 = 0x7fffffff

@@ -55,8 +55,8 @@ class Context {
     return desc_.garment_fit == DRAPE_GARMENT_FIT_SKELETON ? kCutSkeleton : kCutShape;
   }
   // The body in its rest pose for a cut (what garments are fitted and dressed on), built on demand
-  // and cached until the shape or the person's fitted bones change. Without a cut: the context's
-  // own (drape_context_desc.garment_fit).
+  // and cached until the shape or the person's fitted bones change; the overloads without a cut
+  // below take the context's own (drape_context_desc.garment_fit).
   const BodyModel& restBody(RestCut cut);
   const std::vector<Ellipsoid>& restEllipsoids(RestCut cut);
   // The collision groups of each ellipsoid (collisionGroups of its source; same order every frame).

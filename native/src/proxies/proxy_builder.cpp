@@ -162,10 +162,11 @@ void ProxyBuilder::planHipFills(const BodyModel& body) {
 // each side, a band of triangles that the ring ellipsoids cover only near its ends: the thigh ring
 // hangs below the hip joint by the crotch drop, and how far the hip joints sit below the pelvis
 // depends on the skeleton: the stitch is 5 cm long on the Kinect takes, 16 cm on the CMU takes,
-// whose hip joints are the femur heads, 9-10 cm below the pelvis joint. Cloth over the hips sank up to 5 cm into the body mesh there. The fill
-// spans the band: the box of the hip ring's half on that side and of the thigh ring, in a frame
-// with y from the thigh ring's centre to the half's centroid and x the hip ring's forward; its
-// cross-section scaled by kHipFillSection, its length whole (docs/proxies.md, "Hip fills").
+// whose hip joints are the femur heads, 9-10 cm below the pelvis joint. Cloth over the hips sank
+// up to 5 cm into the body mesh there. The fill spans the band: the box of the hip ring's half on
+// that side and of the thigh ring, in a frame with y from the thigh ring's centre to the half's
+// centroid and x the hip ring's forward; its cross-section scaled by kHipFillSection, its length
+// whole (docs/proxies.md, "Hip fills").
 Ellipsoid ProxyBuilder::hipFill(const BodyModel& body, const HipStitch& s) const {
   const auto& rings = body.rings();
   const RingPose& thigh = rings[static_cast<size_t>(s.thigh_ring)];
@@ -185,9 +186,9 @@ void ProxyBuilder::planPelvisFill(const BodyModel& body) {
 // The hip stitch's front and back, and the crotch between the thighs, which the hip fills (one
 // side each, 0.75 across) leave open: on the CMU takes, whose hip stitch is 16 cm long (hip
 // joints 9-10 cm below the pelvis joint), the body mesh there stood up to 65 mm outside every
-// ellipsoid and the T-shirt's hem sank into the lower belly. The fill is the ellipsoid inscribed in the box of the whole hip
-// ring and both thigh rings, in a frame with y from the thighs' mid-point to the hip ring's centre
-// and x the hip ring's forward (docs/proxies.md, "Pelvis fill"). It follows the thighs, as the
+// ellipsoid and the T-shirt's hem sank into the lower belly. The fill is the ellipsoid inscribed
+// in the box of the whole hip ring and both thigh rings, in a frame with y from the thighs'
+// mid-point to the hip ring's centre and x the hip ring's forward (docs/proxies.md, "Pelvis fill"). It follows the thighs, as the
 // body mesh's stitch does, so cloth meets it only while both legs are trusted
 // (GarmentSim::applyLegGroups).
 Ellipsoid ProxyBuilder::pelvisFill(const BodyModel& body) const {
