@@ -15,6 +15,7 @@
 #include "backends/opencl/cl_xpbd_solver.h"
 #endif
 #include "body/mesh_metrics.h"
+#include "cloth/cloth_stats.h"
 #include "cloth/garment_sim.h"
 #include "cloth/garment_topology.h"
 #include "cloth/xpbd_solver.h"
@@ -258,15 +259,11 @@ TEST(OpenClKernels, VertexNormalsMatchCpu) {
 }
 
 GarmentTopology hangingSquare(int n) {
-  std::vector<float> positions;
-  std::vector<uint32_t> indices;
-  makeClothGrid(n, n, 1.0f, 1.0f, Vec3::Zero(), Vec3::UnitX(), Vec3(-Vec3::UnitY()), positions, indices);
+  test::ClothGrid g;
+  g.nx = g.ny = n;
   TopologyParams p;
   p.pinned = {0, static_cast<uint32_t>(n - 1)};
-  GarmentTopology t;
-  std::string error;
-  EXPECT_TRUE(buildGarmentTopology(positions.data(), positions.size() / 3, indices.data(), indices.size(), p, t, error));
-  return t;
+  return test::clothGridTopology(g, p);
 }
 
 TEST(OpenClKernels, TransformMatchesCpu) {
@@ -426,12 +423,11 @@ TEST(OpenClKernels, FrameMatchesXpbdStepWithTheStrainLimit) {
   frameMatchesXpbdStep(rt, false, GarmentSimParams{}.xpbd.strain_limit);
 }
 
-// The largest strain (|d| / rest - 1) over the structural (stretch) edges.
+// The largest strain (|d| / rest - 1) over the structural (stretch) edges, 0 when none is
+// stretched (stretchStats' max, which may be negative).
 float maxStretch(const GarmentTopology& t, const Eigen::Vector4f* x) {
-  float worst = 0.0f;
-  for (size_t k = 0; k < t.stretch.size(); ++k)
-    worst = std::max(worst, (x[t.stretch.a[k]] - x[t.stretch.b[k]]).head<3>().norm() / t.stretch.rest[k] - 1.0f);
-  return worst;
+  std::vector<float> scratch;
+  return std::max(0.0f, stretchStats(t, x, scratch).max);
 }
 
 // The strain limit on both device paths (one work-group, per-phase launches) against

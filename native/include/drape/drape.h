@@ -148,8 +148,9 @@ typedef enum drape_garment_fit {
    * geometry (spine, hip and shoulder joints) averaged over the calibration window, template
    * garments are made again on it with their first layout, OBJ garments carried to it
    * (drape_garment_stats.refits counts it; particles and triangles stay, the rest shape changes).
-   * No refit when the person's rest pose is within 1 cm of the standard one. Less stretch on most shared takes at 2 000 particles, more on
-   * some (skirts on the Kinect takes, coarse garments): docs/garments.md. */
+   * No refit when the person's rest pose is within 1 cm of the standard one. Less stretch on most
+   * shared takes at 2 000 particles, more on some (skirts on the Kinect takes, coarse garments):
+   * docs/garments.md. */
   DRAPE_GARMENT_FIT_SKELETON = 1,
   DRAPE_GARMENT_FIT_FORCE32 = 0x7fffffff
 } drape_garment_fit;

@@ -188,9 +188,9 @@ void ProxyBuilder::planPelvisFill(const BodyModel& body) {
 // joints 9-10 cm below the pelvis joint), the body mesh there stood up to 65 mm outside every
 // ellipsoid and the T-shirt's hem sank into the lower belly. The fill is the ellipsoid inscribed
 // in the box of the whole hip ring and both thigh rings, in a frame with y from the thighs'
-// mid-point to the hip ring's centre and x the hip ring's forward (docs/proxies.md, "Pelvis fill"). It follows the thighs, as the
-// body mesh's stitch does, so cloth meets it only while both legs are trusted
-// (GarmentSim::applyLegGroups).
+// mid-point to the hip ring's centre and x the hip ring's forward (docs/proxies.md, "Pelvis
+// fill"). It follows the thighs, as the body mesh's stitch does, so cloth meets it only while both
+// legs are trusted (GarmentSim::applyLegGroups).
 Ellipsoid ProxyBuilder::pelvisFill(const BodyModel& body) const {
   const auto& rings = body.rings();
   const RingPose& hip = rings[static_cast<size_t>(body.chainFirstRing(Chain::Torso))];
