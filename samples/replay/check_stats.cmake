@@ -2,6 +2,7 @@
 # replay_garment_obj, replay_bvh).
 #   cmake -DEXE=... -DOUT_DIR=... -DARGS="a|b|c" -DEXPECT_FRAMES=N -DEXPECT_OBJ=N
 #         [-DEXPECT_GARMENT=template|obj|none -DEXPECT_GARMENT_OBJ=N -DEXPECT_MEASURED=N]
+#         [-DEXPECT_SUBSTEP_HZ=N (garment.substep_hz)]
 #         [-DEXPECT_FORMAT=kinect_csv] [-DEXPECT_BACKEND=cpu|opencl] [-DVOLUME_MIN_L=x -DVOLUME_MAX_L=y] [-DPYTHON=python3]
 #         [-DEXPECT_RENDERED=N -DEXPECT_PNG_SIZE=WxH -DEXPECT_SHEET=ON|OFF -DEXPECT_GIF=ON|OFF]
 #         -P check_stats.cmake
@@ -223,6 +224,10 @@ else()
   json_get(_gmeasured garment frames_measured)
   if(DEFINED EXPECT_MEASURED)
     expect_equal("garment.frames_measured" "${_gmeasured}" "${EXPECT_MEASURED}")
+  endif()
+  if(DEFINED EXPECT_SUBSTEP_HZ)
+    json_get(_ghz garment substep_hz)
+    expect_equal("garment.substep_hz" "${_ghz}" "${EXPECT_SUBSTEP_HZ}")
   endif()
   if(_gmeasured GREATER 0)
     foreach(path IN LISTS _garment_measured)

@@ -173,9 +173,9 @@ int run(int argc, char** argv) {
     drape_garment_desc_init(&gdesc);
     gdesc.solver = opt.solver;
     if (opt.substeps != 0) cloth.substep_hz = 30.0f * static_cast<float>(opt.substeps);
+    else if (opt.solver == DRAPE_SOLVER_MASS_SPRING) cloth.substep_hz = kMassSpringSubstepHz;
     if (opt.iterations != 0) cloth.iterations = opt.iterations;
     if (opt.strain_limit >= 0.0) cloth.strain_limit = static_cast<float>(opt.strain_limit);
-    else if (opt.solver == DRAPE_SOLVER_MASS_SPRING) cloth.substep_hz = kMassSpringSubstepHz;
     // A frame a little longer than 1/30 s must not hit the per-step cap (which would lengthen
     // every substep instead of adding some).
     const uint32_t per_frame = static_cast<uint32_t>(std::ceil(cloth.substep_hz / 30.0f));
