@@ -234,11 +234,16 @@ void EllipsoidCollider::setEllipsoids(const Ellipsoid* start, const Ellipsoid* e
     const Eigen::Array4i lo = cellsOf(s.swept_min, cell_origin_, cell_scale_, cell_top_);
     const Eigen::Array4i hi = cellsOf(s.swept_max, cell_origin_, cell_scale_, cell_top_);
     const uint64_t bit = uint64_t{1} << (k & 63);
+    // Row by row through a local pointer: indexing cells_ with the members, re-read for every
+    // cell (a store might change them, as far as the compiler knows), cost 0.7 % of the default
+    // replay's instructions (docs/performance.md, "Instruction counts").
+    uint64_t* const first = cells_.data() + (k >> 6);
+    const size_t stride = static_cast<size_t>(words_);
+    const int dx = dims_[0], dy = dims_[1], nx = hi[0] - lo[0] + 1;
     for (int z = lo[2]; z <= hi[2]; ++z) {
       for (int y = lo[1]; y <= hi[1]; ++y) {
-        for (int x = lo[0]; x <= hi[0]; ++x) {
-          cells_[static_cast<size_t>(((z * dims_[1] + y) * dims_[0] + x) * words_ + (k >> 6))] |= bit;
-        }
+        uint64_t* word = first + static_cast<size_t>((z * dy + y) * dx + lo[0]) * stride;
+        for (int x = 0; x < nx; ++x, word += stride) *word |= bit;
       }
     }
   }
