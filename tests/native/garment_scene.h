@@ -20,6 +20,8 @@ struct SceneSummary {
   float max_stretch = 0.0f;        // over all frames
   float p99_stretch_worst = 0.0f;  // worst per-frame P99
   float p99_stretch_median = 0.0f; // median per-frame P99
+  float p99_stretch_p90 = 0.0f;    // 90th percentile of the per-frame P99s (the bad frames, but
+                                   // not one chaotic frame)
   uint64_t proxy_inside = 0;       // summed over frames
   float penetration_p99_max_mm = 0.0f;  // worst per-frame P99 depth inside the body mesh
   float penetration_max_mm = 0.0f;
@@ -148,6 +150,7 @@ inline SceneSummary replay(Context& ctx, GarmentSim& garment, const Recording& r
   if (!p99s.empty()) {
     s.p99_stretch_worst = p99s.back();
     s.p99_stretch_median = p99s[p99s.size() / 2];
+    s.p99_stretch_p90 = p99s[p99s.size() * 9 / 10];
     s.step_ms_median = ms[ms.size() / 2];
   }
   return s;

@@ -182,6 +182,7 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
     g->mesh_.pin_ring[k] = mesh.pin_ring[order[k]];
     g->mesh_.pin_local[k] = mesh.pin_local[order[k]];
   }
+  g->shoulders_.bind(body_rest, g->mesh_.positions, g->mesh_.pinned, g->mesh_.pin_ring);
   if (ellipsoid_groups.size() != rest_ellipsoids.size()) {
     err = "one collision group set per ellipsoid expected";
     return nullptr;
@@ -496,6 +497,7 @@ void GarmentSim::pinTargets(const BodyModel& body, std::vector<Vec3>& out) const
     const RingPose& r = body.rings()[static_cast<size_t>(mesh_.pin_ring[k])];
     out[k] = r.centre + r.frame * mesh_.pin_local[k];
   }
+  shoulders_.shift(body, out);
 }
 
 void GarmentSim::runFrame(const std::vector<Ellipsoid>& start, const std::vector<Ellipsoid>& end,
@@ -539,6 +541,8 @@ void GarmentSim::placeOnBody(const BodyModel& body, const std::vector<Ellipsoid>
   // shirt's hem through the thighs): a leg ellipsoid that holds torso cloth now meets it only
   // once it holds none (updateLegClearance); pushed out at once, the hem tore.
   updateLegClearance(ellipsoids, 3);
+  shoulders_.restart();
+  shoulders_.observe(body, kSettleFrameS);
   pinTargets(body, pins_);
   const int frames = static_cast<int>(std::ceil(params_.blend_in_s / kSettleFrameS - 1e-4f));
   for (int f = 0; f < frames; ++f) runFrame(ellipsoids, ellipsoids, pins_, kSettleFrameS);
@@ -621,6 +625,7 @@ void GarmentSim::stepBegin(const BodyModel& body, const std::vector<Ellipsoid>& 
     // The person is somewhere else in the same pose: move the garment with them, at rest.
     last_.teleport_reset = true;
     carry(pr.frame * seen_pelvis_f_.transpose(), seen_pelvis_c_, pr.centre - seen_pelvis_c_, 0.0f);
+    shoulders_.observe(body, dt);
     pinTargets(body, pins_);
     runStepFrame(end, end, pins_, dt);
   } else if (burst_ended && restoreState(before_burst_, body, pr, end)) {
@@ -632,6 +637,7 @@ void GarmentSim::stepBegin(const BodyModel& body, const std::vector<Ellipsoid>& 
     // The body's start-of-step ellipsoids are carried by the same transform, so garment and body
     // start the step together and only the rest of the motion happens across the substeps
     // (carrying the garment alone would push the trailing side of it into the body).
+    shoulders_.observe(body, dt);
     const float fl = 1.0f - params_.linear_inertia, fa = 1.0f - params_.angular_inertia;
     if (fl > 0.0f || fa > 0.0f) {
       const Mat3 R = partialRotation(pr.frame * seen_pelvis_f_.transpose(), fa);

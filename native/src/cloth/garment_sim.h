@@ -21,6 +21,7 @@
 #include "cloth/garment_topology.h"
 #include "cloth/mass_spring_solver.h"
 #include "cloth/ring_skin.h"
+#include "cloth/shoulder_seams.h"
 #include "cloth/xpbd_solver.h"
 #include "proxies/collision.h"
 #include "proxies/mesh_bvh.h"
@@ -370,6 +371,7 @@ class GarmentSim {
   std::vector<Vec3> dressed_;
   RingSkin skin_;
   GarmentOpenings openings_;  // bound with skin_, to the dressed garment on the rest body
+  ShoulderSeams shoulders_;   // seam pins that follow the shoulders (cloth/shoulder_seams.h)
 
   // Per-step scratch (sized once).
   std::vector<Vec3> pins_, scratch3_;
