@@ -23,7 +23,7 @@ namespace {
 // The long-sleeve's sleeve is cut this much looser than the ease at the armhole, tapering to the
 // plain ease at the cuff: cut to the ease alone, the sleeve root was stretched wherever the arm
 // moved from the pose it was cut in (P99 stretch 13-21 % over the shared takes), and 2 cm there
-// lowered it by 10-33 % on all eight with fewer or as many frames off. The T-shirt and the dress
+// lowered it by 11-32 % on all eight with fewer or as many frames off. The T-shirt and the dress
 // were tried with it and left as they are (docs/garments.md, "A looser long sleeve").
 constexpr float kLongSleeveRootEaseM = 0.02f;
 
@@ -515,6 +515,8 @@ class Builder {
       loop.insert(loop.end(), up.rbegin(), up.rend());
       for (int r = R - 1; r >= 1; --r) loop.push_back(rows[static_cast<size_t>(r)][static_cast<size_t>(wrap(from))]);
       const Chain arm = left ? Chain::ArmL : Chain::ArmR;
+      // Ring points from the perimeter at the plain ease: counted at the looser cut (rootEase), the
+      // long-sleeve's stretch went up again (matrix gm 1.094: docs/garments.md, "A looser long sleeve").
       const Sec s0 = chainSec(body_, arm, 0.0f, e);
       const int Ka = count(roundTo(secPerimeter(s0) / h, 4, 8));
       auto apath = [&](float v) { return chainSec(body_, arm, v * sleeveU, e + rootEase * (1.0f - v)); };
