@@ -19,14 +19,16 @@ void ShoulderSeams::bind(const BodyModel& body_rest, const std::vector<Vec3>& po
   }
   if (!any) return;
   top_ = top;
+  const auto& rings = body_rest.rings();
   const Chain arms[2] = {Chain::ArmL, Chain::ArmR};
   for (int s = 0; s < 2; ++s) {
-    const int n = body_rest.chainRingCount(arms[s]);
+    const int n = body_rest.chainRingCount(arms[s]), j = body_rest.chainFirstRing(arms[s]);
+    // The arm's direction needs a second ring down the upper arm.
+    if (n < 2 || j < 0 || static_cast<size_t>(j + n) > rings.size()) return;
     side_[s] = Side{};
-    side_[s].junction = body_rest.chainFirstRing(arms[s]);
-    side_[s].upper = side_[s].junction + std::max(1, n / 3);
+    side_[s].junction = j;
+    side_[s].upper = j + std::max(1, n / 3);
   }
-  const auto& rings = body_rest.rings();
   pin_side_.assign(pinned.size(), -1);
   for (size_t k = 0; k < pinned.size(); ++k) {
     if (pin_ring[k] != top || pinned[k] >= positions.size()) continue;
