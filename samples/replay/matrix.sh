@@ -8,14 +8,18 @@
 #   TAKES      recordings, space-separated (default: the eight shared takes: the four Kinect v2
 #              takes and the four CMU BVH takes of ../shared/data, those present)
 #   GARMENTS   default "tshirt longsleeve skirt dress trousers"
+#   PARTICLES  template resolutions, space-separated (default: drape-replay's; each run once).
+#              Several (e.g. "1500 2000 2500") run every take x garment at each, named
+#              <take>_<garment>_<N>.json: per-run openings and worst frames are chaotic, and a
+#              change judged over several resolutions is judged on more than one draw.
 #   FRAMES     frames per run (default 300; shorter takes run whole)
 #   MEASURE    --measure-every (default 3)
 #   JOBS       runs at once (default: nproc)
 #   REPLAY     the drape-replay binary (default build/release/samples/drape-replay)
-# Writes OUT_DIR/<take>_<garment>.json and OUT_DIR/args.txt (what the runs were given).
+# Writes OUT_DIR/<take>_<garment>[_<N>].json and OUT_DIR/args.txt (what the runs were given).
 set -euo pipefail
 if [[ $# -lt 1 || "$1" == -* ]]; then
-  sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'
+  sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'
   exit 2
 fi
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -35,17 +39,21 @@ if [[ -z "${TAKES:-}" ]]; then
 fi
 garments="${GARMENTS:-tshirt longsleeve skirt dress trousers}"
 mkdir -p "$out"
-printf '%s\n' "frames ${FRAMES:-300}, measure every ${MEASURE:-3}, extra: $*" > "$out/args.txt"
+printf '%s\n' "frames ${FRAMES:-300}, measure every ${MEASURE:-3}, particles ${PARTICLES:-default}, extra: $*" > "$out/args.txt"
 export REPLAY_BIN="$replay" OUT_DIR="$out" RUN_FRAMES="${FRAMES:-300}" RUN_MEASURE="${MEASURE:-3}"
 # Each run gets the extra options, then its take and garment (xargs appends those two).
 for t in $TAKES; do
   for g in $garments; do
-    printf '%s\0%s\0' "$t" "$g"
+    for n in ${PARTICLES:--}; do
+      printf '%s\0%s\0%s\0' "$t" "$g" "$n"
+    done
   done
-done | xargs -0 -n 2 -P "${JOBS:-$(nproc)}" bash -c '
-  take="${@: -2:1}"; garment="${@: -1}"; set -- "${@:1:$#-2}"
+done | xargs -0 -n 3 -P "${JOBS:-$(nproc)}" bash -c '
+  take="${@: -3:1}"; garment="${@: -2:1}"; particles="${@: -1}"; set -- "${@:1:$#-3}"
   name="$(basename "$take")"; name="${name%.*}_${garment}"
-  "$REPLAY_BIN" --recording "$take" --garment "$garment" --frames "$RUN_FRAMES" --measure-every "$RUN_MEASURE" \
+  res=()
+  if [[ "$particles" != "-" ]]; then name="${name}_${particles}"; res=(--particles "$particles"); fi
+  "$REPLAY_BIN" --recording "$take" --garment "$garment" "${res[@]}" --frames "$RUN_FRAMES" --measure-every "$RUN_MEASURE" \
     --no-obj --no-render --fidelity-every 0 --quiet --stats "$OUT_DIR/$name.json" "$@" \
     || { echo "matrix.sh: $name failed" >&2; exit 255; }
 ' _ "$@"
