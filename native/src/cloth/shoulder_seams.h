@@ -6,7 +6,7 @@
 // arm came down it was outside the sleeve for the rest of the take (docs/garments.md, "Shoulder
 // seams follow the shoulders"). So each seam pin also moves by how far its shoulder (the centre of
 // the arm's junction ring, in the top ring's frame) has moved from where it sat while that arm
-// hung during the first second after the garment was placed on the body.
+// hung: its mean over the first second of hanging-arm frames after the garment was placed.
 //
 // Not for a garment that is also pinned lower on the torso (a dress at its waist): its bodice
 // cannot ride up, and lifting the seams only stretched it (Ges01 dress, P99 8.6 -> 14.4 %).
