@@ -12,12 +12,7 @@ void ShoulderSeams::bind(const BodyModel& body_rest, const std::vector<Vec3>& po
   const int first = body_rest.chainFirstRing(Chain::Torso), count = body_rest.chainRingCount(Chain::Torso);
   if (count <= 0 || pinned.size() != pin_ring.size()) return;
   const int top = first + count - 1;
-  bool any = false;
-  for (int r : pin_ring) {
-    if (r >= first && r < top) return;  // pinned lower on the torso too: the bodice cannot ride up
-    any = any || r == top;
-  }
-  if (!any) return;
+  if (std::find(pin_ring.begin(), pin_ring.end(), top) == pin_ring.end()) return;  // no seam pins
   top_ = top;
   const auto& rings = body_rest.rings();
   const Chain arms[2] = {Chain::ArmL, Chain::ArmR};
