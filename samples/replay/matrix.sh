@@ -39,9 +39,11 @@ if [[ -z "${TAKES:-}" ]]; then
 fi
 garments="${GARMENTS:-tshirt longsleeve skirt dress trousers}"
 mkdir -p "$out"
-printf '%s\n' "frames ${FRAMES:-300}, measure every ${MEASURE:-3}, particles ${PARTICLES:-default}, extra: $*" > "$out/args.txt"
+printf 'frames %s, measure every %s, particles %s, extra: %s\n' "${FRAMES:-300}" "${MEASURE:-3}" \
+  "${PARTICLES:-default}" "$*" > "$out/args.txt"
 export REPLAY_BIN="$replay" OUT_DIR="$out" RUN_FRAMES="${FRAMES:-300}" RUN_MEASURE="${MEASURE:-3}"
-# Each run gets the extra options, then its take and garment (xargs appends those two).
+# Each run gets the extra options, then its take, garment and resolution (xargs appends those
+# three; "-" for drape-replay's own).
 for t in $TAKES; do
   for g in $garments; do
     for n in ${PARTICLES:--}; do
@@ -53,8 +55,8 @@ done | xargs -0 -n 3 -P "${JOBS:-$(nproc)}" bash -c '
   name="$(basename "$take")"; name="${name%.*}_${garment}"
   res=()
   if [[ "$particles" != "-" ]]; then name="${name}_${particles}"; res=(--particles "$particles"); fi
-  "$REPLAY_BIN" --recording "$take" --garment "$garment" "${res[@]}" --frames "$RUN_FRAMES" --measure-every "$RUN_MEASURE" \
-    --no-obj --no-render --fidelity-every 0 --quiet --stats "$OUT_DIR/$name.json" "$@" \
+  "$REPLAY_BIN" --recording "$take" --garment "$garment" "${res[@]}" --frames "$RUN_FRAMES" \
+    --measure-every "$RUN_MEASURE" --no-obj --no-render --fidelity-every 0 --quiet --stats "$OUT_DIR/$name.json" "$@" \
     || { echo "matrix.sh: $name failed" >&2; exit 255; }
 ' _ "$@"
 echo "matrix.sh: $(ls "$out"/*.json | wc -l) runs in $out"

@@ -187,11 +187,16 @@ class Builder {
       rec_->h = h;
     }
     switch (p_.kind) {
-      case GarmentKind::TShirt: upper(h, 0.05f * p_.length_scale + hipDrop_, false, 0.5f * p_.length_scale, 0.0f, m); break;
-      case GarmentKind::LongSleeve:
-        upper(h, 0.05f * p_.length_scale + hipDrop_, false, std::min(2.0f, 1.9f * p_.length_scale), kLongSleeveRootEaseM, m);
+      case GarmentKind::TShirt:
+        upper(h, 0.05f * p_.length_scale + hipDrop_, false, 0.5f * p_.length_scale, 0.0f, m);
         break;
-      case GarmentKind::Dress: upper(h, 0.9f * kneeDrop_ * p_.length_scale, true, 0.35f * p_.length_scale, 0.0f, m); break;
+      case GarmentKind::LongSleeve:
+        upper(h, 0.05f * p_.length_scale + hipDrop_, false, std::min(2.0f, 1.9f * p_.length_scale),
+              kLongSleeveRootEaseM, m);
+        break;
+      case GarmentKind::Dress:
+        upper(h, 0.9f * kneeDrop_ * p_.length_scale, true, 0.35f * p_.length_scale, 0.0f, m);
+        break;
       case GarmentKind::Skirt: skirt(h, m); break;
       case GarmentKind::Trousers: trousers(h, m); break;
     }
