@@ -557,7 +557,9 @@ namespace {
 
 // Inertia scaling: the fraction (1 - inertia) of the pelvis' motion carries the garment directly.
 // A body moving sideways at 1.5 m/s: with inertia 0 a skirt moves exactly with the pelvis; with
-// inertia 1 it is dragged along by its waistband and the legs and its hem lags behind.
+// inertia 1 it is dragged along by its waistband and the legs and its hem lags behind, then
+// swings through (at 0.33 s it leads by a centimetre), so the largest lag over the 0.33 s is
+// what is returned.
 float lagBehindPelvis(float inertia) {
   ContextPtr ctx = makeContext();
   drape_cloth_params c;
@@ -593,17 +595,18 @@ float lagBehindPelvis(float inertia) {
   int i = 0;
   for (; i < 30; ++i) held(i, 0.0f);
   const float before = centroidX(), pelvis_before = pelvisX();
-  float dx = 0.0f;
+  float dx = 0.0f, most = -1.0f;
   for (int k = 0; k < 10; ++k, ++i) {
     dx += 1.5f / 30.0f;
     held(i, dx);
+    most = std::max(most, (pelvisX() - pelvis_before) - (centroidX() - before));
   }
-  return (pelvisX() - pelvis_before) - (centroidX() - before);
+  return most;
 }
 
 TEST(CApiGarments, InertiaScalingCarriesTheGarmentWithThePelvis) {
   const float carried = lagBehindPelvis(0.0f), physical = lagBehindPelvis(1.0f), half = lagBehindPelvis(0.5f);
-  std::printf("[ figures  ] lag behind the pelvis after 0.33 s at 1.5 m/s: inertia 0 %.4f m, 0.5 %.4f m, 1 %.4f m\n",
+  std::printf("[ figures  ] largest lag behind the pelvis over 0.33 s at 1.5 m/s: inertia 0 %.4f m, 0.5 %.4f m, 1 %.4f m\n",
               carried, half, physical);
   EXPECT_NEAR(carried, 0.0f, 0.005f) << "inertia 0: the garment moves with the pelvis";
   EXPECT_GT(physical, carried + 0.005f) << "inertia 1: the garment lags behind";

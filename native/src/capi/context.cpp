@@ -480,7 +480,11 @@ drape_result Context::beginStep(float dt, std::string& err) {
     return tracked.state[idx(hip)] == TrackingState::Tracked && tracked.state[idx(knee)] == TrackingState::Tracked;
   };
   const bool left_leg = trusted(Joint::HipL, Joint::KneeL), right_leg = trusted(Joint::HipR, Joint::KneeR);
-  for (auto& g : garments_) {
+  placement_[kCutShape].aim(this, kCutShape);
+  placement_[kCutSkeleton].aim(this, kCutSkeleton);
+  for (size_t i = 0; i < garments_.size(); ++i) {
+    const std::unique_ptr<GarmentSim>& g = garments_[i];
+    g->setPlacementPath(&placement_[garmentCuts_[i]]);
     if (options_.sleep && adaptive_.asleep(g.get())) {
       g->markSkipped();
       ++slept;

@@ -134,6 +134,25 @@ class Context {
   std::vector<std::unique_ptr<GarmentSim>> garments_;
   std::vector<RestCut> garmentCuts_;  // garments_[i]'s cut
   std::vector<Ellipsoid> stepEllipsoids_;  // the ellipsoids at the end of the last step
+  // The way from each cut's rest pose into the pose now, for the garments placed this step
+  // (cloth/placement_path.h; built only when one asks: capi/context_placement.cpp).
+  class PosePath final : public PlacementPath {
+   public:
+    // This step's: the path's ends and what its poses are built with. Forgets the last step's.
+    void aim(Context* context, RestCut cut);
+    int poses() override;
+    void at(int i, const BodyModel*& body, const std::vector<Ellipsoid>*& ellipsoids) override;
+
+   private:
+    Context* context_ = nullptr;
+    RestCut cut_ = kCutShape;
+    int poses_ = -1;  // not yet worked out this step
+    SkeletonPose rest_{}, now_{};
+    std::unique_ptr<BodyModel> body_;
+    ProxyBuilder proxies_;
+    bool planned_ = false;  // proxies_ copied from the context's builder this step
+  };
+  PosePath placement_[2];
   bool teleportPending_ = false;           // a teleport since the last step
   double stepMs_ = 0.0;
 

@@ -531,22 +531,43 @@ void GarmentSim::carry(const Mat3& R, const Vec3& pivot, const Vec3& t, float ve
   solver_->transform(R, pivot, t, velocity_scale);
 }
 
-// The first tracked frame (or a NaN reset): put the dressed garment where the body's rings carry
-// it now, then let it settle on the new pose with the body held still.
+// The first tracked frame (or a NaN reset, or a pose jump with nothing to restore): put the
+// dressed garment on the body now, then let it settle on the new pose with the body held still.
 void GarmentSim::placeOnBody(const BodyModel& body, const std::vector<Ellipsoid>& ellipsoids) {
-  skin_.place(body, scratch3_);
+  // With a path: skinned onto its first pose (the rest pose where the person stands, which the
+  // dressed shape fits), then carried through the others into this one by the ellipsoids.
+  const int poses = path_ != nullptr ? path_->poses() : 0;
+  const BodyModel* first = &body;
+  const std::vector<Ellipsoid>* first_all = &ellipsoids;
+  if (poses > 0) path_->at(0, first, first_all);
+  skin_.place(*first, scratch3_);
   std::string err;
   solver_->reset(scratch3_, err);
+  shoulders_.restart();
+  if (poses > 0) {
+    path_from_ = pickReachable(*first_all, path_to_);
+    updateLegClearance(path_from_, 3);
+    for (int i = 1; i <= poses; ++i) {
+      const BodyModel* b = &body;
+      const std::vector<Ellipsoid>* all = &ellipsoids;
+      if (i < poses) path_->at(i, b, all);
+      const std::vector<Ellipsoid>& to = i < poses ? pickReachable(*all, path_to_) : ellipsoids;
+      pinTargets(*b, pins_);
+      runFrame(path_from_, to, pins_, kSettleFrameS);
+      path_from_ = to;
+    }
+    // The way here is not the person's motion: the settle below starts from rest.
+    carry(Mat3::Identity(), Vec3::Zero(), Vec3::Zero(), 0.0f);
+  }
   // Placed on a pose the legs may already be in (a person seated from the first frame: the
   // shirt's hem through the thighs): a leg ellipsoid that holds torso cloth now meets it only
   // once it holds none (updateLegClearance); pushed out at once, the hem tore.
   updateLegClearance(ellipsoids, 3);
-  shoulders_.restart();
   shoulders_.observe(body, kSettleFrameS);
   pinTargets(body, pins_);
   const int frames = static_cast<int>(std::ceil(params_.blend_in_s / kSettleFrameS - 1e-4f));
   for (int f = 0; f < frames; ++f) runFrame(ellipsoids, ellipsoids, pins_, kSettleFrameS);
-  last_.blend_frames = frames;
+  last_.blend_frames = poses + frames;
 }
 
 bool GarmentSim::poseJumped(const RingPose& pelvis, float dt) const {

@@ -17,6 +17,7 @@
 #include "body/body_model.h"
 #include "cloth/cloth_stats.h"
 #include "cloth/garment_openings.h"
+#include "cloth/placement_path.h"
 #include "cloth/garment_templates.h"
 #include "cloth/garment_topology.h"
 #include "cloth/mass_spring_solver.h"
@@ -227,6 +228,10 @@ class GarmentSim {
   // particle of this garment can touch, so the result is the same as with all of them. Empty: all.
   void setReachable(const std::vector<int>& indices);
   const std::vector<int>& reachable() const { return reach_; }
+  // Where placeOnBody (the first tracked frame, a pose jump with nothing to restore) takes the
+  // garment from its rest pose into the pose (cloth/placement_path.h); null: skinned straight
+  // onto it. Not owned; the context sets it before each stepBegin.
+  void setPlacementPath(PlacementPath* path) { path_ = path; }
   // The context skipped this garment's step (it is asleep): the last step's statistics say that
   // nothing ran.
   void markSkipped() { last_ = GarmentStepStats{}; }
@@ -285,7 +290,9 @@ class GarmentSim {
   // The pelvis turned farther since the last step than a person can turn in dt.
   bool poseJumped(const RingPose& pelvis, float dt) const;
   void carry(const Mat3& R, const Vec3& pivot, const Vec3& t, float velocity_scale);
-  // Places the dressed garment on `body` by skinning and settles it for blend_in_s.
+  // Places the dressed garment on `body` and settles it for blend_in_s: skinned onto the first
+  // pose of the placement path (setPlacementPath) and carried through its poses into `body`, or,
+  // without one (or on a pose near the rest pose), skinned straight onto `body`.
   void placeOnBody(const BodyModel& body, const std::vector<Ellipsoid>& ellipsoids);
   // Recovery from tracking glitches (garment_recovery.cpp, docs/robustness.md). A skeleton that
   // flips (or is swapped with another person's) for a moment, or a burst of sensor noise, leaves
@@ -366,6 +373,8 @@ class GarmentSim {
   Mat3 seen_pelvis_f_ = Mat3::Identity();
   std::vector<Vec3> seen_pins_;  // attachment targets on the rest body (dressing)
   bool tracked_ = false;  // false until the first step (the garment still sits on the rest pose)
+  PlacementPath* path_ = nullptr;  // setPlacementPath
+  std::vector<Ellipsoid> path_from_, path_to_;  // placeOnBody's scratch: a path pose's reachable ones
 
   // The dressed shape on the rest pose, bound to the rest body's rings.
   std::vector<Vec3> dressed_;
