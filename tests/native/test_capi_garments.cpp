@@ -606,7 +606,8 @@ float lagBehindPelvis(float inertia) {
 
 TEST(CApiGarments, InertiaScalingCarriesTheGarmentWithThePelvis) {
   const float carried = lagBehindPelvis(0.0f), physical = lagBehindPelvis(1.0f), half = lagBehindPelvis(0.5f);
-  std::printf("[ figures  ] largest lag behind the pelvis over 0.33 s at 1.5 m/s: inertia 0 %.4f m, 0.5 %.4f m, 1 %.4f m\n",
+  std::printf("[ figures  ] largest lag behind the pelvis over 0.33 s at 1.5 m/s: inertia 0 %.4f m, 0.5 %.4f m, "
+              "1 %.4f m\n",
               carried, half, physical);
   EXPECT_NEAR(carried, 0.0f, 0.005f) << "inertia 0: the garment moves with the pelvis";
   EXPECT_GT(physical, carried + 0.005f) << "inertia 1: the garment lags behind";

@@ -62,7 +62,8 @@ TEST(PlacementPath, PosesRunFromTheRestPoseWhereThePersonStandsToThePose) {
     EXPECT_NEAR(boneLength(start, jj), boneLength(rest, jj), 1e-5f) << jointName(jj) << ": the rest pose's bones";
   }
   // The rest pose stands as the person does: its hips and spine along theirs.
-  for (Joint j : {Joint::HipR, Joint::SpineMid}) EXPECT_GT(boneDir(start, j).dot(boneDir(now, j)), 0.999f) << jointName(j);
+  for (Joint j : {Joint::HipR, Joint::SpineMid})
+    EXPECT_GT(boneDir(start, j).dot(boneDir(now, j)), 0.999f) << jointName(j);
   // Its arms are still the rest pose's (65 deg down), not the person's.
   EXPECT_LT(boneDir(start, Joint::ElbowL).dot(boneDir(now, Joint::ElbowL)), std::cos(20.0f * kPi / 180.0f));
 

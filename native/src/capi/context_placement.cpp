@@ -35,7 +35,8 @@ int Context::PosePath::poses() {
 
 void Context::PosePath::at(int i, const BodyModel*& body, const std::vector<Ellipsoid>*& ellipsoids) {
   const int n = poses();
-  const SkeletonPose pose = poseBetween(rest_, now_, n > 0 ? static_cast<float>(std::clamp(i, 0, n)) / static_cast<float>(n) : 1.0f);
+  const float u = n > 0 ? static_cast<float>(std::clamp(i, 0, n)) / static_cast<float>(n) : 1.0f;
+  const SkeletonPose pose = poseBetween(rest_, now_, u);
   if (!planned_) {
     // Made afresh on the step that asks (rare): the shape may have changed since the last one.
     BodyModelParams bp;

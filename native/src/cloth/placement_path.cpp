@@ -33,7 +33,7 @@ SkeletonPose restWhereNowStands(const SkeletonPose& rest, const SkeletonPose& no
   const Mat3 q = pelvisFrame(rest, fr) && pelvisFrame(now, fn) ? Mat3(fn * fr.transpose()) : Mat3::Identity();
   const Vec3 from = rest.position[idx(Joint::Pelvis)], to = now.position[idx(Joint::Pelvis)];
   SkeletonPose out = now;
-  for (int j = 0; j < kJointCount; ++j) out.position[static_cast<size_t>(j)] = to + q * (rest.position[static_cast<size_t>(j)] - from);
+  for (size_t j = 0; j < out.position.size(); ++j) out.position[j] = to + q * (rest.position[j] - from);
   return out;
 }
 
@@ -43,8 +43,8 @@ SkeletonPose poseBetween(const SkeletonPose& rest, const SkeletonPose& now, floa
   u = std::clamp(std::isfinite(u) ? u : 0.0f, 0.0f, 1.0f);
   const SkeletonPose start = restWhereNowStands(rest, now);
   SkeletonPose out = now;
-  // Each bone's direction turns in the world frame, not relative to its parent's: a forearm
-  // turned relative to its upper arm took the long-sleeves off more often (docs/garments.md).
+  // Each bone's direction turns in the world frame, not relative to its parent's: turned
+  // relative to the parent, more garments came off on the way (docs/garments.md).
   for (int j = 1; j < kJointCount; ++j) {  // parents come first (joints.h)
     const size_t c = static_cast<size_t>(j), p = static_cast<size_t>(kJointParent[c]);
     const Vec3 a = start.position[c] - start.position[p], b = now.position[c] - now.position[p];
