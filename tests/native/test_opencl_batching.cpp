@@ -154,10 +154,12 @@ void expectSameRuns(const std::vector<std::vector<float>>& a, const std::vector<
     EXPECT_TRUE(sameBits(a[f], b[f])) << "frame " << f << " differs";
     for (float v : a[f]) ASSERT_TRUE(std::isfinite(v)) << "frame " << f;
   }
-  // The cloth moved: the comparison is of a real run, not of a garment standing still.
+  // The cloth moved: the comparison is of a real run, not of a garment standing still. (Over the
+  // take's still first frames, garments carried into the first pose (cloth/placement_path.h)
+  // move at most 4.6 and 8.1 mm in two of these tests under the sanitizers' half sizes.)
   float moved = 0.0f;
   for (size_t k = 0; k < a.front().size(); ++k) moved = std::max(moved, std::fabs(a.back()[k] - a.front()[k]));
-  EXPECT_GT(moved, 0.01f);
+  EXPECT_GT(moved, 0.001f);
 }
 
 #define DRAPE_LOAD_TAKE(take, frames)                                                      \

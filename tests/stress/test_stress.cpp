@@ -20,14 +20,20 @@ constexpr double kStart = 1.5;  // disturbances start here (after the 0.3 s blen
 TEST(StressFrameTimes, FixedRatesFrom240HzTo10Hz) {
   STRESS_REQUIRE_TAKE(take, kComeHere);
   const double seconds = replayedSeconds(take, kStart + 3.0);
-  const Series control = replay(take, fixedTimes(seconds, 1.0 / 30.0));
+  // 400 particles under the sanitizers, as the scenarios about the cloth itself: at 200 the bound
+  // depends on how the coarse shirt happens to lie. Since garments are carried into the first pose
+  // (751842d) the 10 Hz run's median P99 after kStart exceeds the 30 Hz run's by 0.059 in release
+  // and 0.075 under ASan at 200 particles (the tree before passed); at 400 it passes in release and
+  // under ASan, at 1 000 (the plain build) with room (docs/robustness.md, "Sanitizers").
+  const Dressing dressing = clothDressing();
+  const Series control = replay(take, fixedTimes(seconds, 1.0 / 30.0), nullptr, dressing);
   print("30 Hz (undisturbed)", control);
   expectHealthy(control, "30 Hz");
   // Under the sanitizers the two ends: 240 Hz (two substeps a frame, frames shorter than the
   // Kinect's 1/30 s) and 10 Hz (a frame of max_step_s, 30 substeps).
   const double rates[] = {240.0, 120.0, 60.0, 15.0, 10.0};
   for (double hz : variants(rates, {0, 4})) {
-    const Series s = replay(take, fixedTimes(seconds, 1.0 / hz), nullptr, Dressing(), hz > 30 ? int(hz / 30) : 1);
+    const Series s = replay(take, fixedTimes(seconds, 1.0 / hz), nullptr, dressing, hz > 30 ? int(hz / 30) : 1);
     const std::string name = std::to_string(int(hz)) + " Hz";
     print(name.c_str(), s);
     expectHealthy(s, name.c_str());
