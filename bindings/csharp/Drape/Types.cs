@@ -595,7 +595,8 @@ namespace Drape
         /// <summary>angular_inertia: [0, 1]; default 0.5.</summary>
         public float AngularInertia;
         /// <summary>blend_in_s: first frame and teleports blend the new pose in over this much
-        /// simulated time, [0, 2]; default 0.3.</summary>
+        /// simulated time, [0, 2]; default 0.3 (on the first frame after the garment is carried
+        /// into the pose from its rest pose: up to 1 s more, docs/garments.md).</summary>
         public float BlendInS;
         /// <summary>spring_stretch: mass-spring solver only, N/m, [0, 1e6]; default 100.</summary>
         public float SpringStretch;

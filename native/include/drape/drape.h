@@ -474,7 +474,9 @@ typedef struct drape_cloth_params {
   float linear_inertia;        /* [0, 1]: 1 physical, 0 carried rigidly with the pelvis; 0.5 */
   float angular_inertia;       /* [0, 1]; 0.5 */
   float blend_in_s;            /* first frame and teleports: the new pose is blended in over this
-                                  much simulated time, [0, 2]; 0.3 */
+                                  much simulated time, [0, 2]; 0.3 (on the first frame after the
+                                  garment is carried into the pose from its rest pose: up to 1 s
+                                  more, docs/garments.md) */
   float spring_stretch;        /* mass-spring solver only: N/m, [0, 1e6]; 100 */
   float spring_shear;          /* N/m; 20 */
   float spring_bend;           /* N/m; 2 */
