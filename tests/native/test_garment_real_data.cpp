@@ -24,12 +24,13 @@ struct Take {
                     // (docs/garments.md, "Openings": on the CMU takes the sleeves are off the
                     // bent arms; measured, not yet fixed). Ges01: the waving arm's sleeve slid off
                     // at frame 51 and never came back (105 of 154 frames) until the seam pins
-                    // followed the shoulders (cloth/shoulder_seams.h): 31 now, at the end of the
-                    // second raise (docs/garments.md, "Shoulder seams follow the shoulders").
-                    // Close range: 2 of 371 frames (around frame 52) since the shoulder fills
-                    // (docs/proxies.md), none before; the renders of frames 51-53 show the hands
-                    // through the hem at the hips (torso cloth does not collide with the arms'
-                    // ellipsoids)
+                    // followed the shoulders (cloth/shoulder_seams.h): 31 then, at the end of the
+                    // second raise (docs/garments.md, "Shoulder seams follow the shoulders"); 0
+                    // since the garment is carried into the first pose (cloth/placement_path.h).
+                    // Close range: 2 of 371 frames (around frame 52) once the shoulder fills came
+                    // (docs/proxies.md), the renders of frames 51-53 showing the hands through the
+                    // hem at the hips (torso cloth does not collide with the arms' ellipsoids);
+                    // 0 now
 };
 
 const Take kTakes[] = {
