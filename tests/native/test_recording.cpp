@@ -370,11 +370,44 @@ TEST(RecordingBvh, ForwardKinematicsConvention) {
   EXPECT_TRUE(P(f, KneeLeft).isApprox(toKinect(kneeW), 1e-6f)) << P(f, KneeLeft).transpose();
   // Frame 1 has no hip rotation: the knee hangs straight below the hip in the root frame.
   EXPECT_TRUE(P(rec.frames[1], KneeLeft).isApprox(toKinect(hipW + R * Eigen::Vector3d(0, -0.4, 0)), 1e-6f));
-  // Mapping details: SpineMid = Chest, HandTip = finger End Site, Thumb = thumb End Site.
-  EXPECT_TRUE(P(f, SpineMid).isApprox(toKinect(p + R * Eigen::Vector3d(0, 0.25, 0)), 1e-6f));
+  // Mapping details: SpineMid = midpoint of Chest and Chest2, SpineShoulder = Neck, Neck = Head,
+  // Head = the Head's End Site, HandTip = finger End Site, Thumb = thumb End Site.
+  EXPECT_TRUE(P(f, SpineMid).isApprox(toKinect(p + R * Eigen::Vector3d(0, 0.375, 0)), 1e-6f));
+  EXPECT_TRUE(P(f, SpineShoulder).isApprox(toKinect(p + R * Eigen::Vector3d(0, 0.6, 0)), 1e-6f));
+  EXPECT_TRUE(P(f, Neck).isApprox(toKinect(p + R * Eigen::Vector3d(0, 0.7, 0)), 1e-6f));
+  EXPECT_TRUE(P(f, Head).isApprox(toKinect(p + R * Eigen::Vector3d(0, 0.8, 0)), 1e-6f));
   EXPECT_TRUE(P(f, HandTipLeft).isApprox(toKinect(p + R * Eigen::Vector3d(0.18, 0.5 + 0.08 - 0.63, 0)), 1e-6f));
   EXPECT_TRUE(P(f, ThumbRight).isApprox(toKinect(p + R * Eigen::Vector3d(-0.18, 0.5 + 0.08 - 0.56, 0.03)), 1e-6f));
   for (const auto& j : f.joints) EXPECT_EQ(j.state, TrackingState::Tracked);
+}
+
+// A skeleton whose Head has no End Site: the Head is placed as far above the CMU Head as that is
+// above the CMU Neck (a neck bone again), not on the Neck joint (a zero-length Neck-Head bone),
+// and a skeleton without Chest takes the midpoint of Hips and the new SpineShoulder for SpineMid.
+TEST(RecordingBvh, HeadWithoutEndSiteAndNoChest) {
+  const double root[6] = {0, 1.0, 0, 0, 0, 0};
+  std::string text = syntheticBvh({frameLine(root)});
+  const std::string tip = "          End Site\n          {\n            OFFSET 0 0.1 0\n          }\n";
+  const size_t head = text.find("JOINT Head");
+  ASSERT_NE(head, std::string::npos);
+  const size_t at = text.find(tip, head);
+  ASSERT_NE(at, std::string::npos) << "the synthetic skeleton's Head End Site moved";
+  text.erase(at, tip.size());
+  Recording rec;
+  std::string err;
+  ASSERT_TRUE(parseBvhRecording(text, 0, rec, err)) << err;
+  const RecordingFrame& f = rec.frames[0];
+  const Eigen::Vector3d p(0, 1.0, 0);
+  EXPECT_TRUE(P(f, Neck).isApprox(toKinect(p + Eigen::Vector3d(0, 0.7, 0)), 1e-6f)) << P(f, Neck).transpose();
+  EXPECT_TRUE(P(f, Head).isApprox(toKinect(p + Eigen::Vector3d(0, 0.8, 0)), 1e-6f)) << P(f, Head).transpose();
+  // Without Chest (renamed: Chest2 stays Chest2's child of an unknown joint).
+  std::string no_chest = syntheticBvh({frameLine(root)});
+  const size_t chest = no_chest.find("JOINT Chest\n");
+  ASSERT_NE(chest, std::string::npos);
+  no_chest.replace(chest, 12, "JOINT Torso\n");
+  ASSERT_TRUE(parseBvhRecording(no_chest, 0, rec, err)) << err;
+  EXPECT_TRUE(P(rec.frames[0], SpineMid).isApprox(toKinect(p + Eigen::Vector3d(0, 0.3, 0)), 1e-6f))
+      << P(rec.frames[0], SpineMid).transpose();
 }
 
 TEST(RecordingBvh, ChannelOrderIsReadPerJoint) {
@@ -525,6 +558,15 @@ TEST(RecordingBvh, MappedBonesArePlausible) {
     EXPECT_GT(P(f0, ShoulderLeft).y(), P(f0, SpineMid).y());
     EXPECT_GT(P(f0, SpineShoulder).y(), P(f0, SpineMid).y());
     EXPECT_GT(P(f0, SpineMid).y(), P(f0, SpineBase).y());
+    // SpineShoulder level with the shoulders, as a Kinect puts it (3.5-4 cm above them in the
+    // Labanotation captures); CMU's Chest2, mapped there before, was 8 cm below them.
+    const float shoulders = 0.5f * (P(f0, ShoulderLeft).y() + P(f0, ShoulderRight).y());
+    std::printf("[ figures  ] %s: SpineShoulder %.3f m above the shoulders, Neck %.3f, Head %.3f\n", c.file,
+                P(f0, SpineShoulder).y() - shoulders, P(f0, Neck).y() - shoulders, P(f0, Head).y() - shoulders);
+    EXPECT_GT(P(f0, SpineShoulder).y(), shoulders - 0.02f);
+    EXPECT_LT(P(f0, SpineShoulder).y(), shoulders + 0.06f);
+    EXPECT_GT(P(f0, Neck).y(), P(f0, SpineShoulder).y() + 0.04f);
+    EXPECT_GT(P(f0, Head).y(), P(f0, Neck).y() + 0.04f);
     // No two neighbouring joints of the Kinect bone tree coincide (no zero-length bones).
     const std::pair<int, int> bones[] = {{SpineBase, SpineMid}, {SpineMid, SpineShoulder}, {SpineShoulder, Neck},
                                          {Neck, Head}, {WristLeft, HandLeft}, {HandLeft, HandTipLeft},

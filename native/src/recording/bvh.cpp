@@ -315,40 +315,51 @@ bool detectUnit(const Hierarchy& h, Unit& unit, double& extent, std::string& err
 
 struct MapEntry {
   const char* joint;  // CMU/cgspeed joint name
-  bool endSite;       // use the first End Site under that joint (falls back to the joint itself)
+  bool endSite;       // use the first End Site under that joint (see resolveMapping when it has none)
+  const char* with;   // when set and present: the midpoint of `joint` and this joint
 };
-// Index = Kinect v2 JointType. SpineMid (1) falls back to the Hips-Chest2 midpoint without Chest.
+// Index = Kinect v2 JointType. The CMU spine is mapped so that SpineShoulder sits level with the
+// shoulders, as a Kinect puts it (3.5 cm above them in the Labanotation captures): CMU's Chest2 is
+// 8 cm below the shoulder joints, and mapped there the torso's top ring and every top's
+// shoulders sat that far down the arms (docs/recording-format.md, "Joint mapping").
 constexpr MapEntry kKinect2Map[25] = {
-    {"Hips", false},          // 0 SpineBase
-    {"Chest", false},         // 1 SpineMid (lowerback sits on the Hips: zero offset)
-    {"Neck", false},          // 2 Neck
-    {"Head", false},          // 3 Head
-    {"LeftShoulder", false},  // 4 ShoulderLeft
-    {"LeftElbow", false},     // 5 ElbowLeft
-    {"LeftWrist", false},     // 6 WristLeft
-    {"LFingers", false},      // 7 HandLeft (lhand sits on the wrist: zero offset)
-    {"RightShoulder", false}, // 8 ShoulderRight
-    {"RightElbow", false},    // 9 ElbowRight
-    {"RightWrist", false},    // 10 WristRight
-    {"RFingers", false},      // 11 HandRight
-    {"LeftHip", false},       // 12 HipLeft
-    {"LeftKnee", false},      // 13 KneeLeft
-    {"LeftAnkle", false},     // 14 AnkleLeft
-    {"LeftToe", false},       // 15 FootLeft
-    {"RightHip", false},      // 16 HipRight
-    {"RightKnee", false},     // 17 KneeRight
-    {"RightAnkle", false},    // 18 AnkleRight
-    {"RightToe", false},      // 19 FootRight
-    {"Chest2", false},        // 20 SpineShoulder
-    {"LFingers", true},       // 21 HandTipLeft (finger tips)
-    {"LThumb", true},         // 22 ThumbLeft (thumb tip)
-    {"RFingers", true},       // 23 HandTipRight
-    {"RThumb", true},         // 24 ThumbRight
+    {"Hips", false, nullptr},          // 0 SpineBase
+    {"Chest", false, "Chest2"},        // 1 SpineMid (lowerback sits on the Hips: zero offset)
+    {"Head", false, nullptr},          // 2 Neck (CMU Head: the top of the neck)
+    {"Head", true, nullptr},           // 3 Head (the Head's End Site)
+    {"LeftShoulder", false, nullptr},  // 4 ShoulderLeft
+    {"LeftElbow", false, nullptr},     // 5 ElbowLeft
+    {"LeftWrist", false, nullptr},     // 6 WristLeft
+    {"LFingers", false, nullptr},      // 7 HandLeft (lhand sits on the wrist: zero offset)
+    {"RightShoulder", false, nullptr}, // 8 ShoulderRight
+    {"RightElbow", false, nullptr},    // 9 ElbowRight
+    {"RightWrist", false, nullptr},    // 10 WristRight
+    {"RFingers", false, nullptr},      // 11 HandRight
+    {"LeftHip", false, nullptr},       // 12 HipLeft
+    {"LeftKnee", false, nullptr},      // 13 KneeLeft
+    {"LeftAnkle", false, nullptr},     // 14 AnkleLeft
+    {"LeftToe", false, nullptr},       // 15 FootLeft
+    {"RightHip", false, nullptr},      // 16 HipRight
+    {"RightKnee", false, nullptr},     // 17 KneeRight
+    {"RightAnkle", false, nullptr},    // 18 AnkleRight
+    {"RightToe", false, nullptr},      // 19 FootRight
+    {"Neck", false, nullptr},          // 20 SpineShoulder (CMU Neck: the base of the neck, level with the shoulders)
+    {"LFingers", true, nullptr},       // 21 HandTipLeft (finger tips)
+    {"LThumb", true, nullptr},         // 22 ThumbLeft (thumb tip)
+    {"RFingers", true, nullptr},       // 23 HandTipRight
+    {"RThumb", true, nullptr},         // 24 ThumbRight
 };
-constexpr int kSpineMid = 1, kSpineBase = 0, kSpineShoulder = 20;
+constexpr int kSpineMid = 1, kSpineBase = 0, kSpineShoulder = 20, kHead = 3;
 
-// Node index per Kinect joint; -1 for SpineMid means "midpoint of SpineBase and SpineShoulder".
-bool resolveMapping(const Hierarchy& h, std::array<int, 25>& src, std::string& err) {
+// Where each Kinect joint comes from: node a, or the midpoint of a and b (b >= 0); a = -1 for
+// SpineMid means "midpoint of SpineBase and SpineShoulder"; extrapolated: the Head without an End
+// Site, placed as far above the CMU Head as that is above the CMU Neck (not a zero-length bone).
+struct Source {
+  int a = -1, b = -1;
+  bool extrapolated = false;
+};
+
+bool resolveMapping(const Hierarchy& h, std::array<Source, 25>& src, std::string& err) {
   auto find = [&](const char* name) {
     for (std::size_t i = 0; i < h.nodes.size(); ++i)
       if (!h.nodes[i].endSite && equalsIgnoreCase(h.nodes[i].name, name)) return static_cast<int>(i);
@@ -356,18 +367,20 @@ bool resolveMapping(const Hierarchy& h, std::array<int, 25>& src, std::string& e
   };
   std::string missing;
   for (int k = 0; k < 25; ++k) {
+    Source& out = src[static_cast<std::size_t>(k)];
+    out = Source{};
     int i = find(kKinect2Map[k].joint);
     if (i >= 0 && kKinect2Map[k].endSite) {
-      for (std::size_t c = static_cast<std::size_t>(i) + 1; c < h.nodes.size(); ++c) {
-        if (h.nodes[c].parent == i && h.nodes[c].endSite) {
-          i = static_cast<int>(c);
-          break;
-        }
-      }
+      int tip = -1;
+      for (std::size_t c = static_cast<std::size_t>(i) + 1; c < h.nodes.size() && tip < 0; ++c)
+        if (h.nodes[c].parent == i && h.nodes[c].endSite) tip = static_cast<int>(c);
+      if (tip >= 0) i = tip;
+      else out.extrapolated = k == kHead;  // else the joint itself (a hand without its tip)
     }
     if (i < 0 && k != kSpineMid && missing.find(kKinect2Map[k].joint) == std::string::npos)
       missing += std::string(missing.empty() ? "" : ", ") + kKinect2Map[k].joint;
-    src[static_cast<std::size_t>(k)] = i;
+    out.a = i;
+    if (i >= 0 && kKinect2Map[k].with != nullptr) out.b = find(kKinect2Map[k].with);
   }
   if (!missing.empty()) {
     err = "the BVH skeleton lacks joint(s) " + missing +
@@ -428,7 +441,7 @@ bool parseBvh(std::string_view text, int layoutHint, Recording& out, std::string
 
   Unit unit{};
   double extent = 0;
-  std::array<int, 25> src{};
+  std::array<Source, 25> src{};
   if (!detectUnit(h, unit, extent, err) || !resolveMapping(h, src, err)) return false;
 
   // Frame lines.
@@ -498,10 +511,14 @@ bool parseBvh(std::string_view text, int layoutHint, Recording& out, std::string
     RecordingFrame frame;
     frame.time_s = frameIndex * frameTime;
     frame.joints.resize(25);
+    auto at = [&](int node) -> const Eigen::Vector3d& { return pos[static_cast<std::size_t>(node)]; };
     for (std::size_t k = 0; k < 25; ++k) {
+      const Source& from = src[k];
       Eigen::Vector3d w;
-      if (src[k] >= 0) w = pos[static_cast<std::size_t>(src[k])];
-      else w = 0.5 * (pos[static_cast<std::size_t>(src[kSpineBase])] + pos[static_cast<std::size_t>(src[kSpineShoulder])]);
+      if (from.a < 0) w = 0.5 * (at(src[kSpineBase].a) + at(src[kSpineShoulder].a));
+      else if (from.b >= 0) w = 0.5 * (at(from.a) + at(from.b));
+      else if (from.extrapolated) w = 2.0 * at(from.a) - at(src[kSpineShoulder].a);
+      else w = at(from.a);
       w *= unit.metres;
       const Eigen::Vector3d kinect(-w.x(), w.y(), kBvhSensorDistanceM - w.z());
       const Vec3 f = kinect.cast<float>();
