@@ -561,8 +561,10 @@ TEST(RecordingBvh, MappedBonesArePlausible) {
     // SpineShoulder level with the shoulders, as a Kinect puts it (3.5-4 cm above them in the
     // Labanotation captures); CMU's Chest2, mapped there before, was 8 cm below them.
     const float shoulders = 0.5f * (P(f0, ShoulderLeft).y() + P(f0, ShoulderRight).y());
-    std::printf("[ figures  ] %s: SpineShoulder %.3f m above the shoulders, Neck %.3f, Head %.3f\n", c.file,
-                P(f0, SpineShoulder).y() - shoulders, P(f0, Neck).y() - shoulders, P(f0, Head).y() - shoulders);
+    std::printf("[ figures  ] %s: SpineShoulder %.3f m above the shoulders, Neck %.3f, Head %.3f; Head %.3f m above "
+                "SpineBase\n",
+                c.file, P(f0, SpineShoulder).y() - shoulders, P(f0, Neck).y() - shoulders, P(f0, Head).y() - shoulders,
+                P(f0, Head).y() - P(f0, SpineBase).y());
     EXPECT_GT(P(f0, SpineShoulder).y(), shoulders - 0.02f);
     EXPECT_LT(P(f0, SpineShoulder).y(), shoulders + 0.06f);
     EXPECT_GT(P(f0, Neck).y(), P(f0, SpineShoulder).y() + 0.04f);
