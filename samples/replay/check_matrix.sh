@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # CTest replay_matrix: matrix.sh and matrix_compare.py on the bundled take (two garments, a few
 # frames). The same settings twice must give the same numbers (drape-replay is deterministic), and
-# the comparer must see a change of setting (else the first check could not fail).
+# the comparer must see a change of setting (else the first check could not fail), and --by-garment
+# must give each garment its line.
 #   check_matrix.sh DRAPE_REPLAY WORK_DIR
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -20,4 +21,10 @@ if python3 "$here/matrix_compare.py" "$work/a" "$work/c" --fail-if-different >/d
   echo "check_matrix: 5 substeps gave the same figures as 10: the comparer sees no difference" >&2
   exit 1
 fi
-echo "check_matrix: same settings same figures; another setting told apart"
+# --by-garment: one line per garment of the runs (the runs' names take_garment), with the frames off.
+per_garment="$(python3 "$here/matrix_compare.py" "$work/a" "$work/c" --by-garment)"
+for garment in tshirt skirt; do
+  grep -Eq "^  $garment +1 runs .*off frames [0-9]+ -> [0-9]+$" <<<"$per_garment" ||
+    { echo "check_matrix: --by-garment printed no line for $garment:" >&2; echo "$per_garment" >&2; exit 1; }
+done
+echo "check_matrix: same settings same figures; another setting told apart; one line per garment"

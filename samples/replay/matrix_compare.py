@@ -1,15 +1,18 @@
 #!/usr/bin/env python3
 """Compares two quality matrices written by matrix.sh (docs/replay.md, "Quality matrix").
 
-    matrix_compare.py BEFORE_DIR AFTER_DIR [--only SUBSTRING] [--fail-if-different]
+    matrix_compare.py BEFORE_DIR AFTER_DIR [--only SUBSTRING] [--by-garment] [--fail-if-different]
 
 One row per run present in both (take_garment): pooled P99 stretch, frames with an opening off,
 the mean share of vertices deeper than 2 mm in the body, the worst measured frame's body
 penetration P99, particle-frames inside an ellipsoid (and how many frames were measured: the
 off-frame count is out of those); then, per figure, in how many runs it is
 lower / higher / equal, and the geometric mean of the ratios after / before (runs where both are
-positive). Exit status: 0; 1 with --fail-if-different when any figure of any run differs (a
-determinism check: the same tree twice must give the same numbers); 2 on bad input.
+positive). --by-garment adds the same geometric means per garment (a run named
+take_garment[_particles]) with the frames off summed before -> after: a change that helps one
+garment and costs another shows there, where the pooled means hide it. Exit status: 0; 1 with
+--fail-if-different when any figure of any run differs (a determinism check: the same tree twice
+must give the same numbers); 2 on bad input.
 """
 import json
 import math
@@ -46,6 +49,38 @@ def number(read, garment):
     except (KeyError, TypeError):
         return None
     return v if isinstance(v, (int, float)) and math.isfinite(v) else None
+
+
+def garment_of(run):
+    """The garment of a run named take_garment or take_garment_particles (matrix.sh)."""
+    parts = run.split("_")
+    if len(parts) >= 2 and parts[-1].isdigit():
+        parts = parts[:-1]
+    return parts[-1]
+
+
+def by_garment(names, before, after):
+    groups = {}
+    for n in names:
+        groups.setdefault(garment_of(n), []).append(n)
+    print()
+    print("per garment: runs, geometric mean of after / before per figure, frames off summed")
+    for garment in sorted(groups):
+        runs = groups[garment]
+        cells = []
+        for label, read, _ in FIGURES:
+            if label == "off frames":
+                continue
+            logs = []
+            for n in runs:
+                b, a = number(read, before[n][0]), number(read, after[n][0])
+                if a is not None and b is not None and a > 0 and b > 0:
+                    logs.append(math.log(a / b))
+            cells.append(f"{label} " + (f"{math.exp(sum(logs) / len(logs)):.3f}" if logs else "n/a"))
+        off_read = dict((f[0], f[1]) for f in FIGURES)["off frames"]
+        off_b = sum(number(off_read, before[n][0]) or 0 for n in runs)
+        off_a = sum(number(off_read, after[n][0]) or 0 for n in runs)
+        print(f"  {garment:12s} {len(runs):3d} runs  " + "  ".join(cells) + f"  off frames {off_b:.0f} -> {off_a:.0f}")
 
 
 def main(argv):
@@ -100,6 +135,8 @@ def main(argv):
     for k, (label, _, _) in enumerate(FIGURES):
         gm = f"{math.exp(sum(logs[k]) / len(logs[k])):.3f}" if logs[k] else "n/a"
         print(f"  {label:14s} {lower[k]:3d} / {higher[k]:3d} / {equal[k]:3d}   {gm}")
+    if "--by-garment" in argv:
+        by_garment(names, before, after)
     if missing:
         print(f"in one folder only: {', '.join(missing)}")
     if "--fail-if-different" in argv and (differs or missing):
