@@ -21,8 +21,12 @@ struct Take {
   float p99_bound;  // per-frame P99 stretch, worst frame: measured worst + ~25 % (the CMU takes
                     // swing between 0.75 and 1.15 from one setting to the next: chaotic)
   int max_off;      // frames with an opening off its body part allowed, -1 = not checked
-                    // (docs/garments.md, "Openings": on the CMU takes the sleeves are off the
-                    // bent arms; measured, not yet fixed). Ges01: the waving arm's sleeve slid off
+                    // (docs/garments.md, "Openings"). CMU: until the BVH reader put
+                    // SpineShoulder level with the shoulders (docs/garments.md, "CMU takes: the
+                    // spine mapped as a Kinect maps it") the shoulders came through the shirt and a
+                    // sleeve was off in 772 / 417 / 749 / 555 frames of these takes here (worst
+                    // frame's P99 0.74-1.01, inside 95-103); now 0 on the walks and 113 / 125 on
+                    // the hops (airborne phases, arms flung), worst 0.44-0.52. Ges01: the waving arm's sleeve slid off
                     // at frame 51 and never came back (105 of 154 frames) until the seam pins
                     // followed the shoulders (cloth/shoulder_seams.h): 31 then, at the end of the
                     // second raise (docs/garments.md, "Shoulder seams follow the shoulders"); 0
@@ -38,10 +42,10 @@ const Take kTakes[] = {
     {"kinect_v2_msft_labanotation/Ges02_balancinghands.csv", 0.4f, 0},
     {"kinect_v2_msft_labanotation/Ges04_comehere.csv", 0.45f, 0},
     {"kinect_v2_msft_labanotation/KinectReader_joints_closerange.csv", 0.95f, 2},
-    {"cmu_mocap_bvh/131_01.bvh", 1.3f, -1},
-    {"cmu_mocap_bvh/131_03.bvh", 1.3f, -1},
-    {"cmu_mocap_bvh/scaled_131_01.bvh", 1.3f, -1},
-    {"cmu_mocap_bvh/scaled_131_03.bvh", 1.3f, -1},
+    {"cmu_mocap_bvh/131_01.bvh", 1.3f, 40},
+    {"cmu_mocap_bvh/131_03.bvh", 1.3f, 250},
+    {"cmu_mocap_bvh/scaled_131_01.bvh", 1.3f, 40},
+    {"cmu_mocap_bvh/scaled_131_03.bvh", 1.3f, 250},
 };
 
 class GarmentOnRecording : public ::testing::TestWithParam<Take> {};
