@@ -26,10 +26,11 @@ struct Take {
                     // spine mapped as a Kinect maps it") the shoulders came through the shirt and a
                     // sleeve was off in 772 / 417 / 749 / 555 frames of these takes here (worst
                     // frame's P99 0.74-1.01, inside 95-103); now 0 on the walks and 113 / 125 on
-                    // the hops (airborne phases, arms flung), worst 0.44-0.52. Ges01: the waving arm's sleeve slid off
-                    // at frame 51 and never came back (105 of 154 frames) until the seam pins
-                    // followed the shoulders (cloth/shoulder_seams.h): 31 then, at the end of the
-                    // second raise (docs/garments.md, "Shoulder seams follow the shoulders"); 0
+                    // the hops (airborne phases, arms flung), worst 0.44-0.52. Ges01: the waving
+                    // arm's sleeve slid off at frame 51 and never came back (105 of 154 frames)
+                    // until the seam pins followed the shoulders (cloth/shoulder_seams.h): 31
+                    // then, at the end of the second raise (docs/garments.md, "Shoulder seams
+                    // follow the shoulders"); 0
                     // since the garment is carried into the first pose (cloth/placement_path.h).
                     // Close range: 2 of 371 frames (around frame 52) once the shoulder fills came
                     // (docs/proxies.md), the renders of frames 51-53 showing the hands through the
