@@ -60,6 +60,7 @@ def garment_of(run):
 
 
 def by_garment(names, before, after):
+    off_read = dict((f[0], f[1]) for f in FIGURES)["off frames"]
     groups = {}
     for n in names:
         groups.setdefault(garment_of(n), []).append(n)
@@ -77,7 +78,6 @@ def by_garment(names, before, after):
                 if a is not None and b is not None and a > 0 and b > 0:
                     logs.append(math.log(a / b))
             cells.append(f"{label} " + (f"{math.exp(sum(logs) / len(logs)):.3f}" if logs else "n/a"))
-        off_read = dict((f[0], f[1]) for f in FIGURES)["off frames"]
         off_b = sum(number(off_read, before[n][0]) or 0 for n in runs)
         off_a = sum(number(off_read, after[n][0]) or 0 for n in runs)
         print(f"  {garment:12s} {len(runs):3d} runs  " + "  ".join(cells) + f"  off frames {off_b:.0f} -> {off_a:.0f}")

@@ -1,6 +1,7 @@
 // The poses a garment placed this step is carried through, from its cut's rest pose into the
 // pose now (cloth/placement_path.h, docs/garments.md "Dressed by moving into the first pose").
 #include "capi/context.h"
+#include "common/math.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,10 +9,10 @@
 namespace drape {
 namespace {
 // A bone turning less than this from the rest pose: the garment is skinned onto the pose.
-constexpr float kSkinBelowRad = 10.0f * 3.14159265f / 180.0f;
+constexpr float kSkinBelowRad = 10.0f * kPi / 180.0f;
 // Each pose turns the bones at most this much from the one before (one simulated 1/30 s frame),
 // and there are at most kMostPoses (one second).
-constexpr float kTurnPerPoseRad = 6.0f * 3.14159265f / 180.0f;
+constexpr float kTurnPerPoseRad = 6.0f * kPi / 180.0f;
 constexpr int kMostPoses = 30;
 }  // namespace
 
