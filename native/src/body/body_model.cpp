@@ -1,5 +1,6 @@
 #include "body/body_model.h"
 
+#include "body/arm_clearance.h"
 #include "body/mesh_metrics.h"
 
 #include <algorithm>
@@ -284,6 +285,16 @@ void BodyModel::placeRings(const SkeletonPose& pose) {
       rp.side_m = st.side_m;
     }
   }
+  armShift_[0] = armShift_[1] = Vec3::Zero();
+  if (params_.arms_clear_torso) {
+    const int first[2] = {chainFirst_[idx2(Chain::ArmL)], chainFirst_[idx2(Chain::ArmR)]};
+    const int count[2] = {chainCount_[idx2(Chain::ArmL)], chainCount_[idx2(Chain::ArmR)]};
+    ArmClearance c;
+    c.clearance_m = params_.arm_torso_clearance_m;
+    c.weight = armWeight_;
+    keepArmsOutOfTorso(rings_, chainFirst_[idx2(Chain::Torso)], chainCount_[idx2(Chain::Torso)], first, count, c,
+                       armShift_);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -322,8 +333,8 @@ void BodyModel::writeApexes(const SkeletonPose& pose) {
   };
   const Vec3& head = pose.position[idx(Joint::Head)];
   positions_[apexFirst_ + 0] = head + endRing(Chain::Head).frame.col(1) * (1.2f * headR);
-  positions_[apexFirst_ + 1] = pose.position[idx(Joint::HandL)] + endRing(Chain::ArmL).frame.col(1) * (0.045f * H);
-  positions_[apexFirst_ + 2] = pose.position[idx(Joint::HandR)] + endRing(Chain::ArmR).frame.col(1) * (0.045f * H);
+  positions_[apexFirst_ + 1] = pose.position[idx(Joint::HandL)] + endRing(Chain::ArmL).frame.col(1) * (0.045f * H) + armShift_[0];
+  positions_[apexFirst_ + 2] = pose.position[idx(Joint::HandR)] + endRing(Chain::ArmR).frame.col(1) * (0.045f * H) + armShift_[1];
   positions_[apexFirst_ + 3] = pose.position[idx(Joint::FootL)] + endRing(Chain::LegL).frame.col(1) * (0.030f * H);
   positions_[apexFirst_ + 4] = pose.position[idx(Joint::FootR)] + endRing(Chain::LegR).frame.col(1) * (0.030f * H);
 }

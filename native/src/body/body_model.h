@@ -12,6 +12,7 @@
 #include "common/math.h"
 #include "skeleton/joints.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -44,6 +45,12 @@ struct BodyModelParams {
   // The paper's naive fixed shoulder connection ring (normal = the rest arm direction) instead of
   // the dynamic junction; exists only so tests can show what the dynamic junction prevents.
   bool fixed_shoulder_junction = false;
+  // Arm rings that would enter the torso are moved out of it, keeping arm_torso_clearance_m
+  // between the two (body/arm_clearance.h). Off here so that a bare model's rings sit on its
+  // bones; the context turns it on for the tracked body and the poses a garment is carried
+  // through, not for the rest bodies garments are cut on.
+  bool arms_clear_torso = false;
+  float arm_torso_clearance_m = 0.01f;  // [0, 0.05]; kDefaultArmTorsoClearanceM
 };
 
 // One ring's pose this frame. The frame is a proper rotation: x = forward, y = along the chain,
@@ -96,6 +103,9 @@ class BodyModel {
     return left ? shoulderTrisL_ : shoulderTrisR_;
   }
   const ResolvedShape& shape() const { return shape_; }
+  // The share of the arms' push out of the torso applied from the next update on, [0, 1]
+  // (BodyModelParams::arms_clear_torso; 1 by default).
+  void setArmClearanceWeight(float w) { armWeight_ = std::clamp(w, 0.0f, 1.0f); }
 
  private:
   void buildStations();
@@ -110,6 +120,8 @@ class BodyModel {
   int K_ = 20;
   std::vector<RingStation> stations_;  // one per ring (interpolated ones included)
   std::vector<RingPose> rings_;
+  float armWeight_ = 1.0f;
+  Vec3 armShift_[2] = {Vec3::Zero(), Vec3::Zero()};  // the hands' last rings' push, left / right
   int chainFirst_[kChainCount] = {};
   int chainCount_[kChainCount] = {};
 

@@ -102,6 +102,7 @@ Context::Context(const drape_context_desc& desc)
   BodyModelParams bp;
   bp.ring_points = static_cast<int>(desc.ring_points);
   bp.rings_per_segment = static_cast<int>(desc.rings_per_segment);
+  bp.arms_clear_torso = true;
   body_ = std::make_unique<BodyModel>(shape_, bp);
   // Size the ellipsoid arrays once (on the rest pose) so updates never allocate.
   proxies_.build(*body_, restPose(shape_));

@@ -43,11 +43,14 @@ void Context::PosePath::at(int i, const BodyModel*& body, const std::vector<Elli
     BodyModelParams bp;
     bp.ring_points = static_cast<int>(context_->desc_.ring_points);
     bp.rings_per_segment = static_cast<int>(context_->desc_.rings_per_segment);
+    bp.arms_clear_torso = true;
     body_ = std::make_unique<BodyModel>(context_->shape_, bp);
     // The frame's builder, so the ellipsoids come in its count and order (Context::restSlot).
     proxies_ = context_->proxies_;
     planned_ = true;
   }
+  // The arms leave the torso as the pose leaves the rest pose the garment was cut on.
+  body_->setArmClearanceWeight(u);
   body_->update(pose);
   proxies_.build(*body_, pose);
   body = body_.get();

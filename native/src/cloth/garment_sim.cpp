@@ -1,6 +1,7 @@
 #include "cloth/garment_sim.h"
 #include "cloth/garment_solver.h"
 
+#include "body/arm_clearance.h"
 #include "body/mesh_metrics.h"
 #include "cloth/cloth_stats.h"
 
@@ -189,9 +190,21 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
   }
   g->base_groups_ = ellipsoid_groups;
   g->groups_ = ellipsoid_groups;
+  // Each particle collides with the part it lies nearest on the rest body, with that body's arms
+  // clear of the torso as the tracked body's are (body/arm_clearance.h): on the rest rings the
+  // hanging upper arm runs inside the torso's side, and the side panels under it, nearer the
+  // arm's tube than the torso's, met only the arm and sank into the torso as it moved away.
+  std::vector<RingPose> mask_rings = body_rest.rings();
+  {
+    const int arm_first[2] = {body_rest.chainFirstRing(Chain::ArmL), body_rest.chainFirstRing(Chain::ArmR)};
+    const int arm_count[2] = {body_rest.chainRingCount(Chain::ArmL), body_rest.chainRingCount(Chain::ArmR)};
+    Vec3 unused[2];
+    keepArmsOutOfTorso(mask_rings, body_rest.chainFirstRing(Chain::Torso), body_rest.chainRingCount(Chain::Torso),
+                       arm_first, arm_count, ArmClearance{}, unused);
+  }
   g->masks_.resize(g->mesh_.positions.size());
   for (size_t i = 0; i < g->masks_.size(); ++i)
-    g->masks_[i] = maskFor(body_rest, g->mesh_.positions[i], torso_reach != TorsoReach::Torso);
+    g->masks_[i] = maskFor(body_rest, mask_rings, g->mesh_.positions[i], torso_reach != TorsoReach::Torso);
   g->torso_reach_ = torso_reach;
   g->applyLegGroups();  // legs trusted (the rest body's, where the garment is dressed outside them)
   g->kind_ = solver;
@@ -356,8 +369,9 @@ void GarmentSim::replaceWith(GarmentSim&& fresh) {
   burst_restores_ = bursts;
 }
 
-uint8_t GarmentSim::maskFor(const BodyModel& body, const Vec3& p, bool torso_meets_legs) {
-  const int chain = nearestChain(body, p);
+uint8_t GarmentSim::maskFor(const BodyModel& body, const std::vector<RingPose>& rings, const Vec3& p,
+                            bool torso_meets_legs) {
+  const int chain = nearestChain(body, rings, p);
   uint8_t mask = maskForChain(chain);
   if (torso_meets_legs && static_cast<Chain>(chain) == Chain::Torso) {
     // The leg on its side: the nearer thigh ring. One leg only: cloth between the thighs meeting
@@ -452,12 +466,11 @@ uint8_t GarmentSim::maskForChain(int chain) {
   }
 }
 
-int GarmentSim::nearestChain(const BodyModel& body, const Vec3& p) {
+int GarmentSim::nearestChain(const BodyModel& body, const std::vector<RingPose>& rings, const Vec3& p) {
   // Distance to the body surface, approximated by the tube between consecutive ring centres
-  // with the rings' mean semi-axis.
+  // (rings: the body's, or a copy with its arms moved) with the rings' mean semi-axis.
   float best = std::numeric_limits<float>::infinity();
   int chain = 0;
-  const auto& rings = body.rings();
   for (int c = 0; c < kChainCount; ++c) {
     const int first = body.chainFirstRing(static_cast<Chain>(c)), n = body.chainRingCount(static_cast<Chain>(c));
     for (int r = first; r + 1 < first + n || (n == 1 && r == first); ++r) {

@@ -217,11 +217,13 @@ class GarmentSim {
   // shared takes (docs/garments.md, "Torso cloth over the thighs"). Why not always: a leg the
   // sensor only infers is a guess; and an OBJ garment's torso cloth may be a suit's seat, which on
   // a heavy body tore between the hip and thigh ellipsoids.
-  static uint8_t maskFor(const BodyModel& body, const Vec3& p, bool torso_meets_legs);
+  // rings: body's rings, or a copy of them with the arms moved clear of the torso (create()).
+  static uint8_t maskFor(const BodyModel& body, const std::vector<RingPose>& rings, const Vec3& p,
+                         bool torso_meets_legs);
   // Whether each leg's ellipsoids are trusted this frame (Context: hip and knee Tracked); while
   // one is not, torso cloth passes through it as before. Cheap when nothing changed.
   void setLegsTrusted(bool left, bool right);
-  static int nearestChain(const BodyModel& body, const Vec3& p);
+  static int nearestChain(const BodyModel& body, const std::vector<RingPose>& rings, const Vec3& p);
 
   // Proxy culling (capi/adaptive.h): the indices (increasing) of the ellipsoids the garment can
   // reach now; step() hands the collider only those, with their groups. The others are ones no
