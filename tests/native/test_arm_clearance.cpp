@@ -118,7 +118,8 @@ int upperArmPointsInsideTorso(const BodyModel& body, float& deepest_m) {
         int best = t0;
         float best_d = INFINITY;
         for (int t = t0; t < t0 + tn; ++t) {
-          const float d = std::fabs((p - rings[static_cast<size_t>(t)].centre).dot(rings[static_cast<size_t>(t)].frame.col(1)));
+          const RingPose& tr = rings[static_cast<size_t>(t)];
+          const float d = std::fabs((p - tr.centre).dot(tr.frame.col(1)));
           if (d < best_d) best_d = d, best = t;
         }
         const RingPose& t = rings[static_cast<size_t>(best)];

@@ -28,7 +28,8 @@ void keepArmsOutOfTorso(std::vector<RingPose>& rings, int torso_first, int torso
       int best = torso_first;
       float best_d = INFINITY;
       for (int r = torso_first; r <= torso_last; ++r) {
-        const float d = std::fabs((arm.centre - rings[static_cast<size_t>(r)].centre).dot(rings[static_cast<size_t>(r)].frame.col(1)));
+        const RingPose& t = rings[static_cast<size_t>(r)];
+        const float d = std::fabs((arm.centre - t.centre).dot(t.frame.col(1)));
         if (d < best_d) best_d = d, best = r;
       }
       const RingPose& t = rings[static_cast<size_t>(best)];
@@ -39,7 +40,8 @@ void keepArmsOutOfTorso(std::vector<RingPose>& rings, int torso_first, int torso
       const float dist = out.norm();
       if (!(dist > 1e-4f)) continue;  // on the spine: no direction to push in
       const Vec3 dir = out / dist;
-      const float torso_r = armClearanceEllipseRadius(t.forward_m, t.side_m, dir.dot(t.frame.col(0)), dir.dot(t.frame.col(2)));
+      const float torso_r =
+          armClearanceEllipseRadius(t.forward_m, t.side_m, dir.dot(t.frame.col(0)), dir.dot(t.frame.col(2)));
       // The arm ring's reach towards the torso: its ellipse in the direction of -dir, as seen in
       // its own plane (an arm along the spine has no such direction: left alone).
       float ax = -dir.dot(arm.frame.col(0)), az = -dir.dot(arm.frame.col(2));

@@ -333,8 +333,11 @@ void BodyModel::writeApexes(const SkeletonPose& pose) {
   };
   const Vec3& head = pose.position[idx(Joint::Head)];
   positions_[apexFirst_ + 0] = head + endRing(Chain::Head).frame.col(1) * (1.2f * headR);
-  positions_[apexFirst_ + 1] = pose.position[idx(Joint::HandL)] + endRing(Chain::ArmL).frame.col(1) * (0.045f * H) + armShift_[0];
-  positions_[apexFirst_ + 2] = pose.position[idx(Joint::HandR)] + endRing(Chain::ArmR).frame.col(1) * (0.045f * H) + armShift_[1];
+  // A hand moved out of the torso with its arm (arms_clear_torso) keeps its apex beyond its ring.
+  positions_[apexFirst_ + 1] =
+      pose.position[idx(Joint::HandL)] + endRing(Chain::ArmL).frame.col(1) * (0.045f * H) + armShift_[0];
+  positions_[apexFirst_ + 2] =
+      pose.position[idx(Joint::HandR)] + endRing(Chain::ArmR).frame.col(1) * (0.045f * H) + armShift_[1];
   positions_[apexFirst_ + 3] = pose.position[idx(Joint::FootL)] + endRing(Chain::LegL).frame.col(1) * (0.030f * H);
   positions_[apexFirst_ + 4] = pose.position[idx(Joint::FootR)] + endRing(Chain::LegR).frame.col(1) * (0.030f * H);
 }
