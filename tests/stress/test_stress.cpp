@@ -25,6 +25,12 @@ TEST(StressFrameTimes, FixedRatesFrom240HzTo10Hz) {
   // (751842d) the 10 Hz run's median P99 after kStart exceeds the 30 Hz run's by 0.059 in release
   // and 0.075 under ASan at 200 particles (the tree before passed); at 400 it passes in release and
   // under ASan, at 1 000 (the plain build) with room (docs/robustness.md, "Sanitizers").
+  // The median is allowed 0.06 above the 30 Hz run's (0.05 before the arms were kept clear of the
+  // torso, body/arm_clearance.h): that change took the 30 Hz run's median down (0.119 -> 0.100 at
+  // 400 particles in release) and left the 10 Hz run's where it was (0.152 -> 0.148), so at 400
+  // particles the 10 Hz run came 0.0515 above it under ASan and in release. At 1 000: 0.104 and
+  // 0.127, +0.023.
+  constexpr float kMedianRoom = 0.06f;
   const Dressing dressing = clothDressing();
   const Series control = replay(take, fixedTimes(seconds, 1.0 / 30.0), nullptr, dressing);
   print("30 Hz (undisturbed)", control);
@@ -39,7 +45,7 @@ TEST(StressFrameTimes, FixedRatesFrom240HzTo10Hz) {
     expectHealthy(s, name.c_str());
     EXPECT_EQ(s.push_errors, 0);
     // The same motion sampled more or less often: the stretch stays that of the 30 Hz run.
-    EXPECT_LE(s.medianP99(kStart, 1e9), control.medianP99(kStart, 1e9) + 0.05f) << name;
+    EXPECT_LE(s.medianP99(kStart, 1e9), control.medianP99(kStart, 1e9) + kMedianRoom) << name;
     EXPECT_LE(s.maxP99(kStart, 1e9), control.maxP99(kStart, 1e9) + 0.15f) << name;
   }
 }
