@@ -51,6 +51,11 @@ def number(read, garment):
     return v if isinstance(v, (int, float)) and math.isfinite(v) else None
 
 
+def geometric_mean(logs):
+    """exp of the mean of logs of after / before ratios, as printed; "n/a" for none."""
+    return f"{math.exp(sum(logs) / len(logs)):.3f}" if logs else "n/a"
+
+
 def garment_of(run):
     """The garment of a run named take_garment or take_garment_particles (matrix.sh)."""
     parts = run.split("_")
@@ -77,7 +82,7 @@ def by_garment(names, before, after):
                 b, a = number(read, before[n][0]), number(read, after[n][0])
                 if a is not None and b is not None and a > 0 and b > 0:
                     logs.append(math.log(a / b))
-            cells.append(f"{label} " + (f"{math.exp(sum(logs) / len(logs)):.3f}" if logs else "n/a"))
+            cells.append(f"{label} {geometric_mean(logs)}")
         off_b = sum(number(off_read, before[n][0]) or 0 for n in runs)
         off_a = sum(number(off_read, after[n][0]) or 0 for n in runs)
         print(f"  {garment:12s} {len(runs):3d} runs  " + "  ".join(cells) + f"  off frames {off_b:.0f} -> {off_a:.0f}")
@@ -133,8 +138,7 @@ def main(argv):
     print()
     print(f"{len(names)} runs; per figure: lower / higher / equal after, geometric mean of after / before")
     for k, (label, _, _) in enumerate(FIGURES):
-        gm = f"{math.exp(sum(logs[k]) / len(logs[k])):.3f}" if logs[k] else "n/a"
-        print(f"  {label:14s} {lower[k]:3d} / {higher[k]:3d} / {equal[k]:3d}   {gm}")
+        print(f"  {label:14s} {lower[k]:3d} / {higher[k]:3d} / {equal[k]:3d}   {geometric_mean(logs[k])}")
     if "--by-garment" in argv:
         by_garment(names, before, after)
     if missing:

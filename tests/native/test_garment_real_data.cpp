@@ -37,7 +37,7 @@ struct Take {
                     // hem at the hips (torso cloth does not collide with the arms' ellipsoids);
                     // 0 now. Since the arms are kept clear of the torso (body/arm_clearance.h):
                     // the CMU hops 8 / 8, the walks 0, close range 0, Ges01 24 (the waving
-                    // sleeve at this resolution; 0-84 at others before and after, docs/garments.md,
+                    // sleeve at this resolution; 0-85 at others before and after, docs/garments.md,
                     // "Arms clear of the torso"); worst frames' P99 0.21-0.29 on the CMU takes
 };
 

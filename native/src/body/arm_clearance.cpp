@@ -57,4 +57,12 @@ void keepArmsOutOfTorso(std::vector<RingPose>& rings, int torso_first, int torso
   }
 }
 
+void keepArmsOutOfTorso(const BodyModel& layout, std::vector<RingPose>& rings, const ArmClearance& c,
+                        Vec3 shift[2]) {
+  const int first[2] = {layout.chainFirstRing(Chain::ArmL), layout.chainFirstRing(Chain::ArmR)};
+  const int count[2] = {layout.chainRingCount(Chain::ArmL), layout.chainRingCount(Chain::ArmR)};
+  keepArmsOutOfTorso(rings, layout.chainFirstRing(Chain::Torso), layout.chainRingCount(Chain::Torso), first, count,
+                     c, shift);
+}
+
 }  // namespace drape

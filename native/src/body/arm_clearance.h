@@ -14,10 +14,6 @@
 
 namespace drape {
 
-// The gap kept by default: the two layers of cloth the arm rests on (sleeve and torso cloth, each
-// kept 4 mm outside its part) and a little room.
-inline constexpr float kDefaultArmTorsoClearanceM = 0.01f;
-
 struct ArmClearance {
   float clearance_m = kDefaultArmTorsoClearanceM;  // between an arm ring and the torso ring beside it
   float weight = 1.0f;  // the share of each push applied, [0, 1] (a pose path fades it in)
@@ -27,5 +23,8 @@ struct ArmClearance {
 // shift[0], shift[1]: what the left / right arm's last ring moved (its hand apex follows it).
 void keepArmsOutOfTorso(std::vector<RingPose>& rings, int torso_first, int torso_count, const int arm_first[2],
                         const int arm_count[2], const ArmClearance& c, Vec3 shift[2]);
+// The same with the chains where `layout` has them (rings: that model's, or a copy of them).
+void keepArmsOutOfTorso(const BodyModel& layout, std::vector<RingPose>& rings, const ArmClearance& c,
+                        Vec3 shift[2]);
 
 }  // namespace drape

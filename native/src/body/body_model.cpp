@@ -287,13 +287,10 @@ void BodyModel::placeRings(const SkeletonPose& pose) {
   }
   armShift_[0] = armShift_[1] = Vec3::Zero();
   if (params_.arms_clear_torso) {
-    const int first[2] = {chainFirst_[idx2(Chain::ArmL)], chainFirst_[idx2(Chain::ArmR)]};
-    const int count[2] = {chainCount_[idx2(Chain::ArmL)], chainCount_[idx2(Chain::ArmR)]};
     ArmClearance c;
     c.clearance_m = params_.arm_torso_clearance_m;
     c.weight = armWeight_;
-    keepArmsOutOfTorso(rings_, chainFirst_[idx2(Chain::Torso)], chainCount_[idx2(Chain::Torso)], first, count, c,
-                       armShift_);
+    keepArmsOutOfTorso(*this, rings_, c, armShift_);
   }
 }
 

@@ -39,6 +39,11 @@ struct RingStation {
   bool junction = false;   // the dynamic shoulder ring (radius follows the next ring)
 };
 
+// The gap kept between an arm and the torso by default (BodyModelParams::arms_clear_torso): the two
+// layers of cloth the arm rests on (sleeve and torso cloth, each kept 4 mm outside its part) and a
+// little room.
+inline constexpr float kDefaultArmTorsoClearanceM = 0.01f;
+
 struct BodyModelParams {
   int ring_points = 20;           // K: a multiple of 4 in [8, 256]
   int rings_per_segment = 1;      // extra rings interpolated between two stations: [0, 16]
@@ -50,7 +55,7 @@ struct BodyModelParams {
   // bones; the context turns it on for the tracked body and the poses a garment is carried
   // through, not for the rest bodies garments are cut on.
   bool arms_clear_torso = false;
-  float arm_torso_clearance_m = 0.01f;  // [0, 0.05]; kDefaultArmTorsoClearanceM
+  float arm_torso_clearance_m = kDefaultArmTorsoClearanceM;
 };
 
 // One ring's pose this frame. The frame is a proper rotation: x = forward, y = along the chain,

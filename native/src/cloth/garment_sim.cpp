@@ -195,13 +195,8 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
   // hanging upper arm runs inside the torso's side, and the side panels under it, nearer the
   // arm's tube than the torso's, met only the arm and sank into the torso as it moved away.
   std::vector<RingPose> mask_rings = body_rest.rings();
-  {
-    const int arm_first[2] = {body_rest.chainFirstRing(Chain::ArmL), body_rest.chainFirstRing(Chain::ArmR)};
-    const int arm_count[2] = {body_rest.chainRingCount(Chain::ArmL), body_rest.chainRingCount(Chain::ArmR)};
-    Vec3 unused[2];
-    keepArmsOutOfTorso(mask_rings, body_rest.chainFirstRing(Chain::Torso), body_rest.chainRingCount(Chain::Torso),
-                       arm_first, arm_count, ArmClearance{}, unused);
-  }
+  Vec3 unused[2];
+  keepArmsOutOfTorso(body_rest, mask_rings, ArmClearance{}, unused);
   g->masks_.resize(g->mesh_.positions.size());
   for (size_t i = 0; i < g->masks_.size(); ++i)
     g->masks_[i] = maskFor(body_rest, mask_rings, g->mesh_.positions[i], torso_reach != TorsoReach::Torso);
