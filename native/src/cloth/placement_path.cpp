@@ -56,7 +56,7 @@ SkeletonPose poseBetween(const SkeletonPose& rest, const SkeletonPose& now, floa
     if (la < kDegenerateM || lb < kDegenerateM) {
       d = (1.0f - u) * a + u * b;  // a bone of no length has no direction to turn
     } else {
-      const Quat turn = Quat::Identity().slerp(u, Quat::FromTwoVectors(a, b));
+      const Quat turn = Quat::Identity().slerp(u, rotationBetween(a, b));
       d = (turn * (a / la)) * ((1.0f - u) * la + u * lb);
     }
     out.position[c] = out.position[p] + d;
