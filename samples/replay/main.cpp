@@ -142,6 +142,8 @@ int run(int argc, char** argv) {
   if (opt.ring_points != 0) desc.ring_points = opt.ring_points;
   desc.proxy_rule = opt.proxy_rule;
   desc.garment_fit = opt.garment_fit;
+  if (opt.arm_clearance_m == -2.0) desc.arms_clear_torso = 0;
+  else if (opt.arm_clearance_m >= 0.0) desc.arm_torso_clearance_m = static_cast<float>(opt.arm_clearance_m);
   drape_context* raw_ctx = nullptr;
   if (drape_result r = drape_context_create(&desc, &raw_ctx)) {
     if (isFatalLibraryError(r)) return fail(kExitFailure, "drape_context_create failed: " + libraryReason(r));
@@ -216,6 +218,7 @@ int run(int argc, char** argv) {
   st.recording_rate_hz = info.nominal_rate_hz;
   st.ring_points = desc.ring_points;
   st.proxy_rule = desc.proxy_rule;
+  st.arm_clearance_m = desc.arms_clear_torso ? desc.arm_torso_clearance_m : -1.0;
   st.garment_fit = desc.garment_fit;
   if (opt.backend == "opencl") {
     // OpenCL for the cloth; without a working device the library falls back to the CPU and says

@@ -207,6 +207,18 @@ bool parseOptions(int argc, const char* const* argv, Options& o, std::string& er
       if (!takeValue() ||
           !parseChoice(name, value, "paper", DRAPE_PROXY_RULE_PAPER, "drape", DRAPE_PROXY_RULE_DRAPE, o.proxy_rule, error))
         return false;
+    } else if (name == "--arm-clearance") {
+      if (!takeValue()) return false;
+      double v = 0.0;
+      if (value == "off") {
+        o.arm_clearance_m = -2.0;
+      } else if (parseDouble(value, v) && v >= 0.0 && v <= 0.05) {
+        o.arm_clearance_m = v;
+      } else {
+        error = "--arm-clearance '" + value +
+                "' is neither 'off' nor a gap in metres in [0, 0.05] (kept between the arms' rings and the torso's)";
+        return false;
+      }
     } else if (name == "--garment-fit") {
       if (!takeValue() || !parseChoice(name, value, "shape", DRAPE_GARMENT_FIT_SHAPE, "skeleton",
                                        DRAPE_GARMENT_FIT_SKELETON, o.garment_fit, error))
@@ -411,6 +423,8 @@ std::string helpText() {
       "  --frames N            replay at most N frames (N >= 1; default: all)\n"
       "  --ring-points K       points per feature ring: multiple of 4 in [8, 256] (default 20)\n"
       "  --proxy-rule R        tracking ellipsoids: drape (default) or paper (the paper's eq. 5-6)\n"
+      "  --arm-clearance M     gap kept between the arms' rings and the torso's, in [0, 0.05] m\n"
+      "                        (default 0.01), or off (every ring centred on its bone)\n"
       "  --fidelity-every N    measure how closely the ellipsoids fit the body every N frames\n"
       "                        (default 10; 0 = never; about 10 ms per measurement)\n"
       "  --garment G           tshirt (default), longsleeve, skirt, dress, trousers, none (no cloth:\n"

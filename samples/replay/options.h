@@ -17,6 +17,7 @@ struct Options {
   uint32_t ring_points = 0;        // 0: the library default
   int32_t proxy_rule = DRAPE_PROXY_RULE_DRAPE;
   int32_t garment_fit = DRAPE_GARMENT_FIT_SHAPE;
+  double arm_clearance_m = -1.0;   // --arm-clearance: [0, 0.05] m; -1: the library default; -2: off
   uint32_t fidelity_every = 10;    // measure proxy fidelity every N updated frames; 0: never
 
   // The garment (--garment). kind is a drape_garment_kind for a template; garment_none turns the

@@ -142,6 +142,9 @@ std::string statsJson(const ReplayStats& s) {
   w.key("triangles").value(s.triangles);
   w.key("watertight_frames").value(s.watertight_frames);
   w.key("volume_l").value(median(s.volume_l));
+  w.key("arm_clearance_m");
+  if (s.arm_clearance_m >= 0.0) w.value(s.arm_clearance_m);
+  else w.value("off");
   w.endObject();
 
   // fit_p95_mm: per measured frame the larger of the two directions' P95 (body sticking out of

@@ -54,6 +54,7 @@ struct ReplayStats {
   // Tracking ellipsoids: count, rule, and fidelity on the measured frames (mm).
   uint32_t proxy_count = 0;
   int32_t proxy_rule = DRAPE_PROXY_RULE_DRAPE;
+  double arm_clearance_m = -1.0;   // the context's arm_torso_clearance_m; < 0: arms_clear_torso off
   std::vector<double> body_to_proxy_p95, proxy_to_body_p95, fit_max, outside_fraction;
 
   // The garment (has_garment false: --garment none, every key below stays empty/0).

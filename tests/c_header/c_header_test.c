@@ -9,6 +9,7 @@
 #include <drape/drape.h>
 
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -100,6 +101,8 @@ int main(void) {
   /* Context with a desc from drape_context_desc_init. */
   CHECK_OK(drape_context_desc_init(&desc));
   CHECK(desc.struct_size == sizeof(drape_context_desc));
+  CHECK(desc.arms_clear_torso == 1);
+  CHECK(offsetof(drape_context_desc, arms_clear_torso) == DRAPE_CONTEXT_DESC_SIZE_V1);
   CHECK_OK(drape_context_create(&desc, &ctx));
   if (ctx == NULL) {
     fprintf(stderr, "no context: giving up\n");

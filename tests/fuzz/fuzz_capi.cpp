@@ -125,6 +125,10 @@ struct Machine {
     }
     if (mode & 4) d.struct_size = in.u8();  // usually too small
     if (mode & 8) d.garment_fit = static_cast<int32_t>(in.u8() % 3);  // 2 is out of range
+    if (mode & 64) {
+      d.arms_clear_torso = static_cast<int32_t>(in.u8() % 3);  // 2 is out of range
+      d.arm_torso_clearance_m = in.inRange(-0.01f, 0.06f);     // [0, 0.05] in range
+    }
     drape_context* h = nullptr;
     if (DRAPE_FUZZ_CALL(drape_context_create((mode & 16) && (mode & 32) ? nullptr : &d, &h)) == DRAPE_OK) {
       DRAPE_FUZZ_CHECK(h != nullptr, "create OK gives a handle");

@@ -34,23 +34,9 @@ struct SceneSummary {
 };
 
 inline drape_context_desc defaultDesc() {
-  drape_context_desc d{};
-  d.struct_size = sizeof(d);
-  d.ring_points = 20;
-  d.rings_per_segment = 1;
-  d.calibration_frames = 30;
-  d.filter = DRAPE_FILTER_ONE_EURO;
-  const TrackerParams t;
-  d.filter_min_cutoff_hz = t.min_cutoff_hz;
-  d.filter_beta = t.beta;
-  d.filter_d_cutoff_hz = t.d_cutoff_hz;
-  d.smoothing = t.smoothing;
-  d.correction = t.correction;
-  d.prediction = t.prediction;
-  d.jitter_radius_m = t.jitter_radius_m;
-  d.max_deviation_m = t.max_deviation_m;
-  d.teleport_distance_m = t.teleport_distance_m;
-  d.proxy_rule = DRAPE_PROXY_RULE_DRAPE;
+  // The C ABI's defaults (drape_context_desc_init), so a field added to the desc gets its default.
+  drape_context_desc d;
+  drape_context_desc_init(&d);
   return d;
 }
 

@@ -3,6 +3,9 @@
 // inside the torso's.
 #include "body/arm_clearance.h"
 #include "body/body_model.h"
+#include "capi/context.h"
+#include "garment_scene.h"
+#include "proxies/proxy_builder.h"
 #include "recording/recording.h"
 #include "skeleton/layouts.h"
 #include "skeleton/tracker.h"
@@ -211,6 +214,43 @@ TEST(ArmClearanceOnRecording, Ges01sArmsRunInsideTheTorsoOnTheBones) {
   }
   EXPECT_EQ(frames_with, static_cast<int>(rec.frames.size()));
   EXPECT_GT(deepest, 0.01f);
+}
+
+// A garment judges its collision groups with the arms where the tracked body will put them
+// (GarmentSim::create): with the context's arms_clear_torso off they stay on the bones, and more
+// of the torso cloth under a hanging arm is arm cloth. The cut itself does not depend on it.
+TEST(ArmClearance, GarmentGroupsFollowTheContextsSetting) {
+  // The rest pose's arms hang a little away from the torso, so the default 1 cm moves the groups
+  // of a few particles only (2 of 1 000); the widest gap allowed moves more.
+  drape_context_desc on_desc = test::defaultDesc(), off_desc = test::defaultDesc();
+  on_desc.arm_torso_clearance_m = 0.05f;
+  off_desc.arms_clear_torso = 0;
+  Context on(on_desc), off(off_desc);
+  EXPECT_TRUE(on.restBody().params().tracked_arms_clear_torso);
+  EXPECT_FALSE(off.restBody().params().tracked_arms_clear_torso);
+  EXPECT_FALSE(on.restBody().params().arms_clear_torso);  // rest bodies keep their rings on the bones
+  std::string err;
+  GarmentSim* g_on = test::addTemplate(on, GarmentKind::TShirt, 1000, ClothSolverKind::Xpbd, GarmentSimParams{}, err);
+  ASSERT_NE(g_on, nullptr) << err;
+  GarmentSim* g_off = test::addTemplate(off, GarmentKind::TShirt, 1000, ClothSolverKind::Xpbd, GarmentSimParams{}, err);
+  ASSERT_NE(g_off, nullptr) << err;
+  ASSERT_EQ(g_on->mesh().positions.size(), g_off->mesh().positions.size());
+  const uint8_t arms = chainGroup(Chain::ArmL) | chainGroup(Chain::ArmR), torso = chainGroup(Chain::Torso);
+  int arm_on = 0, arm_off = 0, changed = 0, arm_to_torso = 0;
+  for (size_t i = 0; i < g_on->particleMasks().size(); ++i) {
+    ASSERT_EQ(g_on->mesh().positions[i], g_off->mesh().positions[i]) << "particle " << i;
+    const uint8_t a = g_on->particleMasks()[i], b = g_off->particleMasks()[i];
+    arm_on += (a & arms) ? 1 : 0;
+    arm_off += (b & arms) ? 1 : 0;
+    if (a == b) continue;
+    ++changed;
+    arm_to_torso += ((b & arms) && (a & torso) && !(a & arms)) ? 1 : 0;
+  }
+  std::printf("[ figures  ] T-shirt, 1000 particles: %d meet an arm judged with the arms 5 cm clear, %d on the "
+              "bones (%d changed)\n",
+              arm_on, arm_off, changed);
+  EXPECT_GT(changed, 10);
+  EXPECT_EQ(arm_to_torso, changed);  // only arm cloth becoming torso cloth
 }
 
 }  // namespace

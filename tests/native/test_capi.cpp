@@ -473,7 +473,8 @@ TEST(Capi, StaleAndForeignRecordingHandlesAreRejected) {
 // struct_size.
 
 TEST(Capi, StructSizeTooSmallIsRejected) {
-  for (uint32_t bad : {0u, 4u, static_cast<uint32_t>(sizeof(drape_context_desc) - 1)}) {
+  // Below the desc's first layout (DRAPE_CONTEXT_DESC_SIZE_V1; sizes from it up are accepted).
+  for (uint32_t bad : {0u, 4u, DRAPE_CONTEXT_DESC_SIZE_V1 - 1}) {
     SCOPED_TRACE(bad);
     drape_context_desc d;
     ASSERT_OK(drape_context_desc_init(&d));
@@ -568,6 +569,8 @@ TEST(Capi, DescInitFillsDocumentedDefaults) {
   EXPECT_EQ(d.filter, DRAPE_FILTER_ONE_EURO);
   EXPECT_EQ(d.proxy_rule, DRAPE_PROXY_RULE_DRAPE);
   EXPECT_EQ(d.garment_fit, DRAPE_GARMENT_FIT_SHAPE);
+  EXPECT_EQ(d.arms_clear_torso, 1);
+  EXPECT_FLOAT_EQ(d.arm_torso_clearance_m, 0.01f);
   EXPECT_FLOAT_EQ(d.teleport_distance_m, 0.5f);
   EXPECT_GT(d.filter_min_cutoff_hz, 0.0f);
   EXPECT_GE(d.filter_beta, 0.0f);
@@ -637,6 +640,12 @@ TEST(Capi, EveryDescFieldOutOfRangeOrNonFiniteIsRejected) {
       {"jitter_radius_m NaN", [](drape_context_desc& d) { d.jitter_radius_m = kNaN; }, N},
       {"max_deviation_m -0.01", [](drape_context_desc& d) { d.max_deviation_m = -0.01f; }, R},
       {"max_deviation_m NaN", [](drape_context_desc& d) { d.max_deviation_m = kNaN; }, N},
+      {"arms_clear_torso -1", [](drape_context_desc& d) { d.arms_clear_torso = -1; }, R},
+      {"arms_clear_torso 2", [](drape_context_desc& d) { d.arms_clear_torso = 2; }, R},
+      {"arm_torso_clearance_m -0.001", [](drape_context_desc& d) { d.arm_torso_clearance_m = -0.001f; }, R},
+      {"arm_torso_clearance_m 0.0501", [](drape_context_desc& d) { d.arm_torso_clearance_m = 0.0501f; }, R},
+      {"arm_torso_clearance_m NaN", [](drape_context_desc& d) { d.arm_torso_clearance_m = kNaN; }, N},
+      {"arm_torso_clearance_m -Inf", [](drape_context_desc& d) { d.arm_torso_clearance_m = -kInf; }, N},
       {"teleport_distance_m 0", [](drape_context_desc& d) { d.teleport_distance_m = 0; }, R},
       {"teleport_distance_m -1", [](drape_context_desc& d) { d.teleport_distance_m = -1; }, R},
       {"teleport_distance_m 100.5", [](drape_context_desc& d) { d.teleport_distance_m = 100.5f; }, R},
@@ -670,11 +679,8 @@ TEST(Capi, EveryDescFieldOutOfRangeOrNonFiniteIsRejected) {
       {"filter DOUBLE_EXPONENTIAL", [](drape_context_desc& d) { d.filter = DRAPE_FILTER_DOUBLE_EXPONENTIAL; }, DRAPE_OK},
       {"filter_beta 0", [](drape_context_desc& d) { d.filter_beta = 0; }, DRAPE_OK},
       {"smoothing 0", [](drape_context_desc& d) { d.smoothing = 0; }, DRAPE_OK},
-      // KNOWN BUG (native/src/capi/context.cpp, validateContextDesc): the documented inclusive
-      // bound 0.999 is compared as a double, and 0.999f (what any host writes into this float
-      // field) is 0.99900001 > 0.999, so it is rejected as "smoothing = 0.999 is outside
-      // [0, 0.999]". Fix: compare against the float bound, e.g. range("smoothing", d.smoothing,
-      // 0, 0.999f) (or make every bound a float), so the documented edge is accepted.
+      // 0.999f (what a host writes into this float field) is 0.99900001 > 0.999: accepted
+      // because validateContextDesc compares as float (it once compared as double and refused it).
       {"smoothing 0.999", [](drape_context_desc& d) { d.smoothing = 0.999f; }, DRAPE_OK},
       {"filter_min_cutoff_hz 0.001", [](drape_context_desc& d) { d.filter_min_cutoff_hz = 0.001f; }, DRAPE_OK},
       {"filter_min_cutoff_hz 1000", [](drape_context_desc& d) { d.filter_min_cutoff_hz = 1000.0f; }, DRAPE_OK},
@@ -693,6 +699,9 @@ TEST(Capi, EveryDescFieldOutOfRangeOrNonFiniteIsRejected) {
       {"teleport_distance_m 0.01", [](drape_context_desc& d) { d.teleport_distance_m = 0.01f; }, DRAPE_OK},
       {"proxy_rule PAPER", [](drape_context_desc& d) { d.proxy_rule = DRAPE_PROXY_RULE_PAPER; }, DRAPE_OK},
       {"proxy_rule DRAPE", [](drape_context_desc& d) { d.proxy_rule = DRAPE_PROXY_RULE_DRAPE; }, DRAPE_OK},
+      {"arms_clear_torso 0", [](drape_context_desc& d) { d.arms_clear_torso = 0; }, DRAPE_OK},
+      {"arm_torso_clearance_m 0", [](drape_context_desc& d) { d.arm_torso_clearance_m = 0; }, DRAPE_OK},
+      {"arm_torso_clearance_m 0.05", [](drape_context_desc& d) { d.arm_torso_clearance_m = 0.05f; }, DRAPE_OK},
   };
   for (const Case& k : edges) {
     SCOPED_TRACE(k.name);
@@ -704,6 +713,65 @@ TEST(Capi, EveryDescFieldOutOfRangeOrNonFiniteIsRejected) {
     EXPECT_NE(out, nullptr);
     EXPECT_OK(drape_context_destroy(out));
   }
+}
+
+// The arm clearance (drape_context_desc.arms_clear_torso, arm_torso_clearance_m) moves only the
+// arms' ellipsoids, and a desc of the first layout (struct_size DRAPE_CONTEXT_DESC_SIZE_V1, the
+// bytes after it whatever the caller's memory holds) gets the defaults of the fields after it.
+TEST(Capi, ArmClearanceMovesOnlyTheArmsAndAFirstLayoutDescGetsItsDefaults) {
+  auto ellipsoidsAfter = [](const drape_context_desc* d) {
+    drape_context* c = nullptr;
+    EXPECT_OK(drape_context_create(d, &c));
+    ContextPtr owner(c);
+    for (int i = 0; i < 3; ++i) pushAndUpdate(c, DRAPE_LAYOUT_KINECT2, i);
+    Mesh m;
+    readEllipsoidsInto(c, m);
+    return m.ellipsoids;
+  };
+  drape_context_desc d;
+  ASSERT_OK(drape_context_desc_init(&d));
+  const std::vector<drape_ellipsoid> dflt = ellipsoidsAfter(&d);
+  d.arms_clear_torso = 0;
+  const std::vector<drape_ellipsoid> off = ellipsoidsAfter(&d);
+  d.arms_clear_torso = 1;
+  d.arm_torso_clearance_m = 0.03f;
+  const std::vector<drape_ellipsoid> wide = ellipsoidsAfter(&d);
+  ASSERT_EQ(dflt.size(), off.size());
+  ASSERT_EQ(dflt.size(), wide.size());
+  auto dist = [](const drape_vec3& a, const drape_vec3& b) {
+    return std::sqrt((a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y) + (a.z - b.z) * (a.z - b.z));
+  };
+  float moved = 0.0f, moved_wide = 0.0f;
+  for (size_t k = 0; k < dflt.size(); ++k) {
+    SCOPED_TRACE(k);
+    const bool arm = dflt[k].chain == 2 || dflt[k].chain == 3;
+    if (!arm) {
+      // Torso, head and legs: the same to the bit whatever the arms do.
+      EXPECT_EQ(std::memcmp(&dflt[k], &off[k], sizeof(drape_ellipsoid)), 0);
+      EXPECT_EQ(std::memcmp(&dflt[k], &wide[k], sizeof(drape_ellipsoid)), 0);
+      continue;
+    }
+    moved = std::max(moved, dist(dflt[k].centre, off[k].centre));
+    moved_wide = std::max(moved_wide, dist(wide[k].centre, off[k].centre));
+  }
+  // The synthetic pose hangs the arms against the torso (shoulders 18 cm from the spine): the
+  // default 1 cm gap moves some arm ellipsoid, a 3 cm gap moves it farther.
+  EXPECT_GT(moved, 0.002f);
+  EXPECT_GT(moved_wide, moved + 0.01f);
+  std::printf("[ figures  ] arm ellipsoids moved off the bones by up to %.1f mm (1 cm gap), %.1f mm (3 cm)\n",
+              1000.0f * moved, 1000.0f * moved_wide);
+
+  // A caller built against the first layout: struct_size 64, then whatever its memory holds
+  // where the later fields are (here arms_clear_torso 0x5A5A5A5A, out of range if it were read).
+  drape_context_desc v1;
+  ASSERT_OK(drape_context_desc_init(&v1));
+  v1.struct_size = DRAPE_CONTEXT_DESC_SIZE_V1;
+  std::memset(reinterpret_cast<unsigned char*>(&v1) + DRAPE_CONTEXT_DESC_SIZE_V1, 0x5A,
+              sizeof(v1) - DRAPE_CONTEXT_DESC_SIZE_V1);
+  const std::vector<drape_ellipsoid> first = ellipsoidsAfter(&v1);
+  ASSERT_EQ(first.size(), dflt.size());
+  EXPECT_EQ(std::memcmp(first.data(), dflt.data(), dflt.size() * sizeof(drape_ellipsoid)), 0)
+      << "a first-layout desc did not get the arm clearance's defaults";
 }
 
 TEST(Capi, MeshSizeFollowsTheDesc) {

@@ -58,8 +58,10 @@ namespace Drape.Tests
         public void ContextDesc_Defaults_AndACustomRingCountChangesTheMesh()
         {
             ContextDesc d = ContextDesc.CreateDefault();
-            Assert.Equal(64u, d.StructSize);
+            Assert.Equal(72u, d.StructSize);
             Assert.Equal(20u, d.RingPoints);
+            Assert.True(d.IsArmsClearTorso);
+            Assert.Equal(0.01f, d.ArmTorsoClearanceM);
             Assert.Equal(1u, d.RingsPerSegment);
             Assert.Equal(30u, d.CalibrationFrames);
             Assert.Equal(Filter.OneEuro, d.Filter);
@@ -69,6 +71,34 @@ namespace Drape.Tests
             d.RingPoints = 32;
             using var finer = new Context(d);
             Assert.True(finer.GetBodyMeshSize().VertexCount > standard.GetBodyMeshSize().VertexCount);
+        }
+
+        [Fact]
+        public void ContextDesc_ArmsClearTorso_MovesOnlyTheArmEllipsoids()
+        {
+            Ellipsoid[] After(ContextDesc desc)
+            {
+                using var ctx = new Context(desc);
+                Run(ctx, 3);
+                var e = new Ellipsoid[ctx.GetEllipsoidCount()];
+                Assert.Equal(e.Length, ctx.ReadEllipsoids(e));
+                return e;
+            }
+            ContextDesc d = ContextDesc.CreateDefault();
+            Ellipsoid[] clear = After(d);
+            d.IsArmsClearTorso = false;
+            Ellipsoid[] onBones = After(d);
+            Assert.Equal(clear.Length, onBones.Length);
+            float moved = 0f;
+            for (int k = 0; k < clear.Length; ++k)
+            {
+                var a = clear[k].Centre;
+                var b = onBones[k].Centre;
+                float dist = MathF.Sqrt((a.X - b.X) * (a.X - b.X) + (a.Y - b.Y) * (a.Y - b.Y) + (a.Z - b.Z) * (a.Z - b.Z));
+                if (clear[k].Chain == 2 || clear[k].Chain == 3) moved = MathF.Max(moved, dist);
+                else Assert.Equal(0f, dist);  // torso, head and legs stay where they were
+            }
+            Assert.True(moved > 0.002f, $"the arms hang against the torso: some arm ellipsoid moves ({moved} m)");
         }
 
         [Fact]
@@ -87,6 +117,20 @@ namespace Drape.Tests
             Assert.Contains("garment_fit", e.NativeMessage);
             d.GarmentFit = GarmentFit.Skeleton;
             using (new Context(d)) { }
+
+            d = ContextDesc.CreateDefault();
+            d.ArmTorsoClearanceM = 0.06f;
+            e = Assert.Throws<DrapeException>(() => new Context(d));
+            Assert.Equal(ResultCode.OutOfRange, e.Code);
+            Assert.Contains("arm_torso_clearance_m", e.NativeMessage);
+            d.ArmTorsoClearanceM = float.NaN;
+            e = Assert.Throws<DrapeException>(() => new Context(d));
+            Assert.Equal(ResultCode.NonFinite, e.Code);
+            d = ContextDesc.CreateDefault();
+            d.ArmsClearTorso = 2;
+            e = Assert.Throws<DrapeException>(() => new Context(d));
+            Assert.Equal(ResultCode.OutOfRange, e.Code);
+            Assert.Contains("arms_clear_torso", e.NativeMessage);
 
             e = Assert.Throws<DrapeException>(() => new Context(default(ContextDesc)));  // struct_size 0
             Assert.Equal(ResultCode.InvalidArgument, e.Code);

@@ -138,11 +138,11 @@ namespace Drape.Tests
         [Fact] public void Joint_Is16() => AssertLayout<Joint>(16, ("Position", 0), ("TrackingState", 12));
 
         [Fact]
-        public void ContextDesc_Is64() => AssertLayout<ContextDesc>(64,
+        public void ContextDesc_Is72() => AssertLayout<ContextDesc>(72,
             ("StructSize", 0), ("RingPoints", 4), ("RingsPerSegment", 8), ("CalibrationFrames", 12), ("Filter", 16),
             ("FilterMinCutoffHz", 20), ("FilterBeta", 24), ("FilterDCutoffHz", 28), ("Smoothing", 32), ("Correction", 36),
             ("Prediction", 40), ("JitterRadiusM", 44), ("MaxDeviationM", 48), ("TeleportDistanceM", 52),
-            ("ProxyRule", 56), ("GarmentFit", 60));
+            ("ProxyRule", 56), ("GarmentFit", 60), ("ArmsClearTorso", 64), ("ArmTorsoClearanceM", 68));
 
         [Fact]
         public void BodyShape_Is48() => AssertLayout<BodyShape>(48,

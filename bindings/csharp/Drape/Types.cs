@@ -297,6 +297,22 @@ namespace Drape
         public ProxyRule ProxyRule;
         /// <summary>garment_fit (int32_t in C); default <see cref="Drape.GarmentFit.Shape"/>.</summary>
         public GarmentFit GarmentFit;
+        /// <summary>arms_clear_torso (int32_t 0 or 1): 1 (default) moves an arm ring that would run
+        /// inside the torso (a hanging arm) out of it, <see cref="ArmTorsoClearanceM"/> apart, so
+        /// sleeve and torso cloth both have room; the body mesh's arms then sit up to a few
+        /// centimetres off the tracked joints. 0 keeps every ring on its bone. See
+        /// <see cref="IsArmsClearTorso"/>.</summary>
+        public int ArmsClearTorso;
+        /// <summary>arm_torso_clearance_m: gap kept between an arm ring and the torso ring beside it,
+        /// [0, 0.05] m; default 0.01.</summary>
+        public float ArmTorsoClearanceM;
+
+        /// <summary><see cref="ArmsClearTorso"/> as a bool.</summary>
+        public bool IsArmsClearTorso
+        {
+            get => ArmsClearTorso != 0;
+            set => ArmsClearTorso = value ? 1 : 0;
+        }
 
         /// <summary>The library's defaults (drape_context_desc_init).</summary>
         public static unsafe ContextDesc CreateDefault()

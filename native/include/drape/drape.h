@@ -9,7 +9,9 @@
  *    returns DRAPE_ERROR_INVALID_HANDLE; it is never dereferenced.
  *  - `*_desc`/`*_shape` structs start with `struct_size`: fill them with their `*_init` function
  *    (sets defaults and struct_size) and then change the fields you need. A struct_size smaller than
- *    the first released version of the struct is rejected, so uninitialised structs are caught.
+ *    the first released version of the struct is rejected, so uninitialised structs are caught;
+ *    fields added to a struct later are appended, and a caller built with the earlier header
+ *    (a smaller struct_size) gets their defaults.
  *  - Buffers: the caller allocates and passes (pointer, capacity); the library writes and never keeps
  *    the pointer. Size queries tell the capacity needed. Nothing the caller owns is modified when a
  *    call fails.
@@ -175,7 +177,21 @@ typedef struct drape_context_desc {
   int32_t proxy_rule;            /* drape_proxy_rule: how tracking ellipsoids are built;
                                     default DRAPE_PROXY_RULE_DRAPE */
   int32_t garment_fit;           /* drape_garment_fit; default DRAPE_GARMENT_FIT_SHAPE (0) */
+  /* The last two fields came after the rest: a desc whose struct_size is
+   * DRAPE_CONTEXT_DESC_SIZE_V1 (64, the layout without them) is accepted and gets their defaults. */
+  int32_t arms_clear_torso;      /* 1 (default): an arm ring that would run inside the torso (a
+                                    hanging arm: sensors put the shoulder joints close to the
+                                    spine) is moved out of it, arm_torso_clearance_m apart, so the
+                                    sleeve and the torso cloth under it both have room; the body
+                                    mesh's arms then sit up to a few centimetres off the tracked
+                                    joints (docs/body-model.md, "Arms clear of the torso").
+                                    0: every ring centred on its bone (the paper). 0 or 1 */
+  float arm_torso_clearance_m;   /* gap kept between an arm ring and the torso ring beside it,
+                                    [0, 0.05] m; 0.01 (two layers of cloth at their 4 mm margin) */
 } drape_context_desc;
+
+/* sizeof(drape_context_desc) before arms_clear_torso and arm_torso_clearance_m. */
+#define DRAPE_CONTEXT_DESC_SIZE_V1 64u
 
 /* Fills `desc` with defaults and struct_size. */
 DRAPE_API drape_result DRAPE_CALL drape_context_desc_init(drape_context_desc* desc);

@@ -56,6 +56,10 @@ struct BodyModelParams {
   // through, not for the rest bodies garments are cut on.
   bool arms_clear_torso = false;
   float arm_torso_clearance_m = kDefaultArmTorsoClearanceM;
+  // For a rest body garments are cut on (arms_clear_torso off, its rings on the bones): whether
+  // the tracked bodies it stands for keep their arms clear, arm_torso_clearance_m apart, so a
+  // garment judges its collision groups with the arms where they will be (GarmentSim::create).
+  bool tracked_arms_clear_torso = true;
 };
 
 // One ring's pose this frame. The frame is a proper rotation: x = forward, y = along the chain,
@@ -108,6 +112,7 @@ class BodyModel {
     return left ? shoulderTrisL_ : shoulderTrisR_;
   }
   const ResolvedShape& shape() const { return shape_; }
+  const BodyModelParams& params() const { return params_; }
   // The share of the arms' push out of the torso applied from the next update on, [0, 1]
   // (BodyModelParams::arms_clear_torso; 1 by default).
   void setArmClearanceWeight(float w) { armWeight_ = std::clamp(w, 0.0f, 1.0f); }

@@ -3,6 +3,7 @@
 #include "capi/context.h"
 
 #include <algorithm>
+#include <cstddef>
 #include <cstring>
 #include <memory>
 
@@ -52,6 +53,8 @@ DRAPE_API drape_result DRAPE_CALL drape_context_desc_init(drape_context_desc* de
   desc->max_deviation_m = t.max_deviation_m;
   desc->teleport_distance_m = t.teleport_distance_m;
   desc->proxy_rule = DRAPE_PROXY_RULE_DRAPE;
+  desc->arms_clear_torso = 1;
+  desc->arm_torso_clearance_m = drape::kDefaultArmTorsoClearanceM;
   return DRAPE_OK;
 }
 
@@ -62,9 +65,16 @@ DRAPE_API drape_result DRAPE_CALL drape_context_create(const drape_context_desc*
     drape_context_desc d;
     drape_context_desc_init(&d);
     if (desc) {
-      if (drape_result r = checkStructSize(desc->struct_size, sizeof(drape_context_desc), "drape_context_desc"))
+      if (drape_result r = checkStructSize(desc->struct_size, DRAPE_CONTEXT_DESC_SIZE_V1, "drape_context_desc"))
         return r;
-      d = *desc;
+      // A caller's desc of an earlier layout: the fields its struct_size covers whole, the later
+      // ones' defaults (left by init).
+      std::memcpy(&d, desc, DRAPE_CONTEXT_DESC_SIZE_V1);
+      auto covers = [&](size_t offset, size_t size) { return desc->struct_size >= offset + size; };
+      if (covers(offsetof(drape_context_desc, arms_clear_torso), sizeof(d.arms_clear_torso)))
+        d.arms_clear_torso = desc->arms_clear_torso;
+      if (covers(offsetof(drape_context_desc, arm_torso_clearance_m), sizeof(d.arm_torso_clearance_m)))
+        d.arm_torso_clearance_m = desc->arm_torso_clearance_m;
       d.struct_size = sizeof(drape_context_desc);
     }
     std::string err;
@@ -352,7 +362,9 @@ DRAPE_API drape_result DRAPE_CALL drape_context_measure_proxy_fidelity(drape_con
 static_assert(sizeof(drape_vec3) == 12, "drape_vec3 layout");
 static_assert(sizeof(drape_quat) == 16, "drape_quat layout");
 static_assert(sizeof(drape_joint) == 16, "drape_joint layout");
-static_assert(sizeof(drape_context_desc) == 64, "drape_context_desc layout");
+static_assert(sizeof(drape_context_desc) == 72, "drape_context_desc layout");
+static_assert(offsetof(drape_context_desc, arms_clear_torso) == DRAPE_CONTEXT_DESC_SIZE_V1,
+              "drape_context_desc: the fields after the first layout are appended");
 static_assert(sizeof(drape_ellipsoid) == 68, "drape_ellipsoid layout");
 static_assert(sizeof(drape_proxy_fidelity) == 40, "drape_proxy_fidelity layout");
 static_assert(sizeof(drape_body_shape) == 48, "drape_body_shape layout");

@@ -73,6 +73,10 @@ drape_result validateContextDesc(const drape_context_desc& d, std::string& err) 
   } else if (d.proxy_rule != DRAPE_PROXY_RULE_PAPER && d.proxy_rule != DRAPE_PROXY_RULE_DRAPE) {
     s << "context desc: proxy_rule = " << d.proxy_rule << " is not 0 (paper) or 1 (drape)";
     r = DRAPE_ERROR_OUT_OF_RANGE;
+  } else if (d.arms_clear_torso != 0 && d.arms_clear_torso != 1) {
+    s << "context desc: arms_clear_torso = " << d.arms_clear_torso << " is not 0 or 1";
+    r = DRAPE_ERROR_OUT_OF_RANGE;
+  } else if ((r = range("arm_torso_clearance_m", d.arm_torso_clearance_m, 0.0f, 0.05f)) != DRAPE_OK) {
   }
   err = s.str();
   return r;
@@ -94,16 +98,22 @@ TrackerParams trackerParamsFrom(const drape_context_desc& d) {
   return p;
 }
 
+BodyModelParams bodyParamsFrom(const drape_context_desc& d, bool own_arms_clear) {
+  BodyModelParams bp;
+  bp.ring_points = static_cast<int>(d.ring_points);
+  bp.rings_per_segment = static_cast<int>(d.rings_per_segment);
+  bp.arms_clear_torso = own_arms_clear && d.arms_clear_torso != 0;
+  bp.tracked_arms_clear_torso = d.arms_clear_torso != 0;
+  bp.arm_torso_clearance_m = d.arm_torso_clearance_m;
+  return bp;
+}
+
 Context::Context(const drape_context_desc& desc)
     : desc_(desc),
       shape_(resolveShape(BodyShapeInput{})),
       tracker_(trackerParamsFrom(desc)),
       proxies_(static_cast<ProxyRule>(desc.proxy_rule)) {
-  BodyModelParams bp;
-  bp.ring_points = static_cast<int>(desc.ring_points);
-  bp.rings_per_segment = static_cast<int>(desc.rings_per_segment);
-  bp.arms_clear_torso = true;
-  body_ = std::make_unique<BodyModel>(shape_, bp);
+  body_ = std::make_unique<BodyModel>(shape_, bodyParamsFrom(desc, true));
   // Size the ellipsoid arrays once (on the rest pose) so updates never allocate.
   proxies_.build(*body_, restPose(shape_));
   orientations_.reserve(32);
@@ -388,10 +398,7 @@ Context::RestCut Context::cutFor(int32_t garment_cut) const {
 Context::RestSlot& Context::restSlot(RestCut cut) {
   RestSlot& r = rest_[cut];  // kCutShape 0, kCutSkeleton 1
   if (!r.body) {
-    BodyModelParams bp;
-    bp.ring_points = static_cast<int>(desc_.ring_points);
-    bp.rings_per_segment = static_cast<int>(desc_.rings_per_segment);
-    auto b = std::make_unique<BodyModel>(shape_, bp);
+    auto b = std::make_unique<BodyModel>(shape_, bodyParamsFrom(desc_, false));
     const SkeletonPose pose = garmentRestPose(cut);
     b->update(pose);
     // The tracked body's builder, so the ellipsoids come in the same count and order as every

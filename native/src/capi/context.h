@@ -212,5 +212,9 @@ class Context {
 // Validates a context desc (ranges documented in drape.h). Returns DRAPE_OK or an error + message.
 drape_result validateContextDesc(const drape_context_desc& d, std::string& err);
 TrackerParams trackerParamsFrom(const drape_context_desc& d);
+// The body model of a context with desc d: ring layout and arm clearance. own_arms_clear: whether
+// this model moves its own arm rings (the tracked body and the pose path's) or only carries the
+// setting for the garments cut on it (a rest body: BodyModelParams::tracked_arms_clear_torso).
+BodyModelParams bodyParamsFrom(const drape_context_desc& d, bool own_arms_clear);
 
 }  // namespace drape

@@ -40,11 +40,7 @@ void Context::PosePath::at(int i, const BodyModel*& body, const std::vector<Elli
   const SkeletonPose pose = poseBetween(rest_, now_, u);
   if (!planned_) {
     // Made afresh on the step that asks (rare): the shape may have changed since the last one.
-    BodyModelParams bp;
-    bp.ring_points = static_cast<int>(context_->desc_.ring_points);
-    bp.rings_per_segment = static_cast<int>(context_->desc_.rings_per_segment);
-    bp.arms_clear_torso = true;
-    body_ = std::make_unique<BodyModel>(context_->shape_, bp);
+    body_ = std::make_unique<BodyModel>(context_->shape_, bodyParamsFrom(context_->desc_, true));
     // The frame's builder, so the ellipsoids come in its count and order (Context::restSlot).
     proxies_ = context_->proxies_;
     planned_ = true;

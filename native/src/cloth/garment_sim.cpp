@@ -194,9 +194,12 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
   // clear of the torso as the tracked body's are (body/arm_clearance.h): on the rest rings the
   // hanging upper arm runs inside the torso's side, and the side panels under it, nearer the
   // arm's tube than the torso's, met only the arm and sank into the torso as it moved away.
+  // (Not when the tracked bodies keep their rings on the bones: BodyModelParams.)
   std::vector<RingPose> mask_rings = body_rest.rings();
-  Vec3 unused[2];
-  keepArmsOutOfTorso(body_rest, mask_rings, ArmClearance{}, unused);
+  if (body_rest.params().tracked_arms_clear_torso) {
+    Vec3 unused[2];
+    keepArmsOutOfTorso(body_rest, mask_rings, ArmClearance{body_rest.params().arm_torso_clearance_m, 1.0f}, unused);
+  }
   g->masks_.resize(g->mesh_.positions.size());
   for (size_t i = 0; i < g->masks_.size(); ++i)
     g->masks_[i] = maskFor(body_rest, mask_rings, g->mesh_.positions[i], torso_reach != TorsoReach::Torso);
