@@ -142,8 +142,8 @@ int run(int argc, char** argv) {
   if (opt.ring_points != 0) desc.ring_points = opt.ring_points;
   desc.proxy_rule = opt.proxy_rule;
   desc.garment_fit = opt.garment_fit;
-  if (opt.arm_clearance_m == -2.0) desc.arms_clear_torso = 0;
-  else if (opt.arm_clearance_m >= 0.0) desc.arm_torso_clearance_m = static_cast<float>(opt.arm_clearance_m);
+  if (opt.arms_on_bones) desc.arms_clear_torso = 0;
+  if (opt.arm_clearance_m >= 0.0) desc.arm_torso_clearance_m = static_cast<float>(opt.arm_clearance_m);
   drape_context* raw_ctx = nullptr;
   if (drape_result r = drape_context_create(&desc, &raw_ctx)) {
     if (isFatalLibraryError(r)) return fail(kExitFailure, "drape_context_create failed: " + libraryReason(r));

@@ -211,9 +211,10 @@ bool parseOptions(int argc, const char* const* argv, Options& o, std::string& er
       if (!takeValue()) return false;
       double v = 0.0;
       if (value == "off") {
-        o.arm_clearance_m = -2.0;
+        o.arms_on_bones = true;
       } else if (parseDouble(value, v) && v >= 0.0 && v <= 0.05) {
         o.arm_clearance_m = v;
+        o.arms_on_bones = false;
       } else {
         error = "--arm-clearance '" + value +
                 "' is neither 'off' nor a gap in metres in [0, 0.05] (kept between the arms' rings and the torso's)";

@@ -17,7 +17,8 @@ struct Options {
   uint32_t ring_points = 0;        // 0: the library default
   int32_t proxy_rule = DRAPE_PROXY_RULE_DRAPE;
   int32_t garment_fit = DRAPE_GARMENT_FIT_SHAPE;
-  double arm_clearance_m = -1.0;   // --arm-clearance: [0, 0.05] m; -1: the library default; -2: off
+  double arm_clearance_m = -1.0;   // --arm-clearance M: [0, 0.05] m; < 0: the library default
+  bool arms_on_bones = false;      // --arm-clearance off: drape_context_desc.arms_clear_torso 0
   uint32_t fidelity_every = 10;    // measure proxy fidelity every N updated frames; 0: never
 
   // The garment (--garment). kind is a drape_garment_kind for a template; garment_none turns the
