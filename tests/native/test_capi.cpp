@@ -2049,15 +2049,9 @@ TEST(Capi, DescSettingsTakeEffect) {
 // never dereferenced." That must hold even when the allocator hands the destroyed object's
 // address to the next object created - the common case with glibc, which reuses a freed block of
 // the same size at once.
-// KNOWN BUG (native/src/capi/api_support.cpp registerHandle/isLiveHandle, used by
-// capi_context.cpp and capi_recording.cpp): a handle is the object's address and liveness is "the
-// address is in the registry", so after drape_context_destroy(a); drape_context_create(&b) with
-// b == a, every call with the stale `a` silently works on `b` (measured: same address on the
-// first create after a destroy; drape_context_update(a) then returns CALL_ORDER from b instead of
-// INVALID_HANDLE, and drape_context_destroy(a) would destroy b). Fix: make the handle value
-// something that is never reused while the process lives, e.g. a 64-bit (generation << 32 | slot)
-// token looked up in a table, or a small never-freed/never-reused handle block pointing at the
-// object.
+// Handles were once the objects' addresses, so a stale `a` reused as `b`'s address silently worked
+// on `b` (drape_context_update(a) answered CALL_ORDER from b); they are tokens never handed out
+// twice since (api_support.h, registerHandle), and this test is what would see the bug come back.
 TEST(Capi, StaleHandleStaysInvalidWhenItsAddressIsReused) {
   // destroy immediately followed by create, a few times (nothing else allocates in between).
   std::vector<drape_context*> destroyed;
