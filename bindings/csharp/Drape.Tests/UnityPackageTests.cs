@@ -163,6 +163,42 @@ namespace Drape.Tests
         }
 
         [Fact]
+        public void DrapeDresser_ArmsClearTorso_ReachesTheContext()
+        {
+            Vector3[] BodyAfterUpdates(bool armsClear)
+            {
+                var go = new GameObject("person");
+                var source = go.AddComponent<RecordingJointSourceBehaviour>();
+                Set(source, "recording", new TextAsset(SyntheticKinect2.Csv(30)));
+                var bodyGo = new GameObject("body");
+                MeshFilter bodyFilter = bodyGo.AddComponent<MeshFilter>();
+                var dresser = go.AddComponent<DrapeDresser>();
+                Set(dresser, "particles", 300);
+                Set(dresser, "garmentMesh", go.AddComponent<MeshFilter>());
+                Set(dresser, "bodyMesh", bodyFilter);
+                if (!armsClear) Set(dresser, "armsClearTorso", false);
+                Message(dresser, "OnEnable");
+                Assert.True(dresser.enabled, string.Join("\n", UnityEngine.Debug.StandInLog));
+                Time.deltaTime = 1f / 30f;
+                for (int i = 0; i < 5; ++i) Message(dresser, "Update");
+                Vector3[] v = (Vector3[])bodyFilter.sharedMesh!.StandInVertices!.Clone();
+                Message(dresser, "OnDisable");
+                return v;
+            }
+            Vector3[] clear = BodyAfterUpdates(true), onBones = BodyAfterUpdates(false);
+            Assert.Equal(clear.Length, onBones.Length);
+            float moved = 0f;
+            for (int i = 0; i < clear.Length; ++i)
+            {
+                float dx = clear[i].x - onBones[i].x, dy = clear[i].y - onBones[i].y, dz = clear[i].z - onBones[i].z;
+                moved = MathF.Max(moved, MathF.Sqrt(dx * dx + dy * dy + dz * dz));
+            }
+            // The synthetic person's arms hang against the torso: with the default some arm vertex
+            // sits off where the rings on the bones put it.
+            Assert.True(moved > 0.002f, $"largest body vertex difference {moved} m");
+        }
+
+        [Fact]
         public void DrapeDresser_UpdatesGarmentAndBodyMeshesEveryFrame_WithoutAllocating()
         {
             var go = new GameObject("person");

@@ -37,6 +37,8 @@ namespace Drape.Samples
         [Header("Body (optional)")]
         [Tooltip("Receives the body mesh; leave empty not to read the body.")]
         [SerializeField] private MeshFilter bodyMesh = null;
+        [Tooltip("Arms kept clear of the torso (the default): a hanging arm's rings move out of the torso so the sleeve and the torso cloth both have room, and the body's arms then sit up to a few centimetres off the tracked joints. Off: every ring on its bone, e.g. to overlay the body on the sensor's image (docs/body-model.md).")]
+        [SerializeField] private bool armsClearTorso = true;
 
         [Header("Space")]
         [Tooltip("Drape's space is right-handed; X turns it into Unity's left-handed one as seen from the sensor.")]
@@ -79,7 +81,9 @@ namespace Drape.Samples
         {
             try
             {
-                _loop = new DressingLoop(FindSource());
+                ContextDesc contextDesc = ContextDesc.CreateDefault();
+                contextDesc.IsArmsClearTorso = armsClearTorso;
+                _loop = new DressingLoop(FindSource(), contextDesc);
                 GarmentTemplate tmpl = GarmentTemplate.CreateDefault(garment);
                 if (particles > 0) tmpl.Particles = (uint)particles;
                 GarmentDesc desc = GarmentDesc.CreateDefault();
