@@ -38,7 +38,7 @@ TEST(GarmentLegGroups, TemplateTorsoClothMeetsTheLegOnItsSide) {
     size_t left = 0, right = 0;
     for (size_t i = 0; i < masks.size(); ++i) {
       const uint8_t m = masks[i];
-      EXPECT_EQ(GarmentSim::maskFor(body, body.rings(), rest[i], false) & kOverBits, 0) << "particle " << i;
+      EXPECT_EQ(GarmentSim::maskFor(body, body.rings(), rest[i], false, true) & kOverBits, 0) << "particle " << i;
       const bool torso = (m & chainGroup(Chain::Torso)) && !(m & (kLegBits | kArmBits));
       if (!torso) {
         EXPECT_EQ(m & kOverBits, 0) << "sleeve or trouser-leg particle " << i;

@@ -200,9 +200,12 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
     Vec3 unused[2];
     keepArmsOutOfTorso(body_rest, mask_rings, ArmClearance{body_rest.params().arm_torso_clearance_m, 1.0f}, unused);
   }
+  // With the arms clear, the upper arm's sleeve cloth meets the torso too (maskFor).
+  const bool sleeve_meets_torso = body_rest.params().tracked_arms_clear_torso;
   g->masks_.resize(g->mesh_.positions.size());
   for (size_t i = 0; i < g->masks_.size(); ++i)
-    g->masks_[i] = maskFor(body_rest, mask_rings, g->mesh_.positions[i], torso_reach != TorsoReach::Torso);
+    g->masks_[i] = maskFor(body_rest, mask_rings, g->mesh_.positions[i], torso_reach != TorsoReach::Torso,
+                           sleeve_meets_torso);
   g->torso_reach_ = torso_reach;
   g->applyLegGroups();  // legs trusted (the rest body's, where the garment is dressed outside them)
   g->kind_ = solver;
@@ -368,9 +371,13 @@ void GarmentSim::replaceWith(GarmentSim&& fresh) {
 }
 
 uint8_t GarmentSim::maskFor(const BodyModel& body, const std::vector<RingPose>& rings, const Vec3& p,
-                            bool torso_meets_legs) {
-  const int chain = nearestChain(body, rings, p);
+                            bool torso_meets_legs, bool sleeve_meets_torso) {
+  float u = 0.0f;
+  const int chain = nearestChain(body, rings, p, &u);
   uint8_t mask = maskForChain(chain);
+  const bool arm = static_cast<Chain>(chain) == Chain::ArmL || static_cast<Chain>(chain) == Chain::ArmR;
+  if (sleeve_meets_torso && arm && u >= kSleeveMeetsTorsoFrom && u <= kSleeveMeetsTorsoTo)
+    mask = static_cast<uint8_t>(mask | chainGroup(Chain::Torso));
   if (torso_meets_legs && static_cast<Chain>(chain) == Chain::Torso) {
     // The leg on its side: the nearer thigh ring. One leg only: cloth between the thighs meeting
     // both would be caught between them.
@@ -464,7 +471,7 @@ uint8_t GarmentSim::maskForChain(int chain) {
   }
 }
 
-int GarmentSim::nearestChain(const BodyModel& body, const std::vector<RingPose>& rings, const Vec3& p) {
+int GarmentSim::nearestChain(const BodyModel& body, const std::vector<RingPose>& rings, const Vec3& p, float* u) {
   // Distance to the body surface, approximated by the tube between consecutive ring centres
   // (rings: the body's, or a copy with its arms moved) with the rings' mean semi-axis.
   float best = std::numeric_limits<float>::infinity();
@@ -482,6 +489,10 @@ int GarmentSim::nearestChain(const BodyModel& body, const std::vector<RingPose>&
       if (d < best) {
         best = d;
         chain = c;
+        if (u != nullptr) {
+          const auto& st = body.stations();
+          *u = (1.0f - t) * st[static_cast<size_t>(r)].u + t * st[static_cast<size_t>(n == 1 ? r : r + 1)].u;
+        }
       }
     }
   }

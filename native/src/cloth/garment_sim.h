@@ -218,12 +218,25 @@ class GarmentSim {
   // sensor only infers is a guess; and an OBJ garment's torso cloth may be a suit's seat, which on
   // a heavy body tore between the hip and thigh ellipsoids.
   // rings: body's rings, or a copy of them with the arms moved clear of the torso (create()).
+  // sleeve_meets_torso: the cloth nearest an upper arm, from kSleeveMeetsTorsoFrom to
+  // kSleeveMeetsTorsoTo of the way from the shoulder joint to the elbow, also collides with the
+  // torso. create() sets it when the tracked bodies keep their arms clear of the torso
+  // (BodyModelParams::tracked_arms_clear_torso), which leaves room for it between the two. Why:
+  // a hanging sleeve's inner side, meeting only the arm, fell into the torso beside it (Ges01's
+  // worst frame: 12.9 mm P99, sleeve vertices up to 31 mm deep; docs/garments.md, "Sleeves meet
+  // the torso"). Not the armpit end (the arm's junction ellipsoids overlap the torso's, cloth
+  // there would be caught between them) nor the elbow end and the forearm (no clearance there:
+  // the elbows hang against the hips, forearms cross the belly).
   static uint8_t maskFor(const BodyModel& body, const std::vector<RingPose>& rings, const Vec3& p,
-                         bool torso_meets_legs);
+                         bool torso_meets_legs, bool sleeve_meets_torso);
+  static constexpr float kSleeveMeetsTorsoFrom = 0.3f, kSleeveMeetsTorsoTo = 0.8f;
   // Whether each leg's ellipsoids are trusted this frame (Context: hip and knee Tracked); while
   // one is not, torso cloth passes through it as before. Cheap when nothing changed.
   void setLegsTrusted(bool left, bool right);
-  static int nearestChain(const BodyModel& body, const std::vector<RingPose>& rings, const Vec3& p);
+  // The body chain whose surface p is nearest (rings: as maskFor's). u, when given: where along
+  // that chain, in its joints' units (an arm: 0 at the shoulder joint, 1 at the elbow).
+  static int nearestChain(const BodyModel& body, const std::vector<RingPose>& rings, const Vec3& p,
+                          float* u = nullptr);
 
   // Proxy culling (capi/adaptive.h): the indices (increasing) of the ellipsoids the garment can
   // reach now; step() hands the collider only those, with their groups. The others are ones no
