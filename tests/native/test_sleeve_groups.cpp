@@ -22,7 +22,8 @@ constexpr uint8_t kArmL = chainGroup(Chain::ArmL), kArmR = chainGroup(Chain::Arm
 // default), the cloth nearest an upper arm between kSleeveMeetsTorsoFrom and kSleeveMeetsTorsoTo of
 // the way to the elbow meets that arm and the torso, and nothing else does: not the armpit end,
 // not the elbow and forearm, not the torso cloth. With the arms on their bones no sleeve cloth
-// meets the torso.
+// meets the torso, nor when the gap between arm and torso leaves no room for two layers of cloth
+// (clearance up to twice the garment's collision margin).
 TEST(SleeveGroups, OnlyTheUpperArmsSleeveClothMeetsTheTorso) {
   drape_context_desc clear_desc = test::defaultDesc(), bones_desc = test::defaultDesc();
   bones_desc.arms_clear_torso = 0;
@@ -69,6 +70,29 @@ TEST(SleeveGroups, OnlyTheUpperArmsSleeveClothMeetsTheTorso) {
   for (size_t i = 0; i < g_bones->particleMasks().size(); ++i) {
     const uint8_t m = g_bones->particleMasks()[i];
     EXPECT_FALSE((m & (kArmL | kArmR)) && (m & kTorso)) << "particle " << i << ", arms on the bones";
+  }
+
+  // No room: 8 mm between arm and torso and the default 4 mm margin; 1 cm and a 6 mm margin.
+  drape_context_desc tight_desc = test::defaultDesc();
+  tight_desc.arm_torso_clearance_m = 0.008f;
+  Context tight(tight_desc);
+  GarmentSimParams thick;
+  thick.collision_margin_m = 0.006f;
+  const struct {
+    Context* ctx;
+    GarmentSimParams params;
+    const char* what;
+  } no_room[] = {{&tight, GarmentSimParams{}, "8 mm clearance"}, {&clear, thick, "6 mm margin"}};
+  for (const auto& c : no_room) {
+    GarmentSim* n = test::addTemplate(*c.ctx, GarmentKind::LongSleeve, 1500, ClothSolverKind::Xpbd, c.params, err);
+    ASSERT_NE(n, nullptr) << err;
+    int sleeve = 0;
+    for (size_t i = 0; i < n->particleMasks().size(); ++i) {
+      const uint8_t m = n->particleMasks()[i];
+      sleeve += (m & (kArmL | kArmR)) ? 1 : 0;
+      EXPECT_FALSE((m & (kArmL | kArmR)) && (m & kTorso)) << "particle " << i << ", " << c.what;
+    }
+    EXPECT_GT(sleeve, 300) << c.what;
   }
 }
 

@@ -299,7 +299,8 @@ namespace Drape
         public GarmentFit GarmentFit;
         /// <summary>arms_clear_torso (int32_t 0 or 1): 1 (default) moves an arm ring that would run
         /// inside the torso (a hanging arm) out of it, <see cref="ArmTorsoClearanceM"/> apart, so
-        /// sleeve and torso cloth both have room; the body mesh's arms then sit up to a few
+        /// sleeve and torso cloth both have room, and garments' upper sleeves also collide with the
+        /// torso, so a hanging sleeve stays out of it; the body mesh's arms then sit up to a few
         /// centimetres off the tracked joints. 0 keeps every ring on its bone. See
         /// <see cref="IsArmsClearTorso"/>.</summary>
         public int ArmsClearTorso;

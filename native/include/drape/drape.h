@@ -182,9 +182,12 @@ typedef struct drape_context_desc {
   int32_t arms_clear_torso;      /* 1 (default): an arm ring that would run inside the torso (a
                                     hanging arm: sensors put the shoulder joints close to the
                                     spine) is moved out of it, arm_torso_clearance_m apart, so the
-                                    sleeve and the torso cloth under it both have room; the body
-                                    mesh's arms then sit up to a few centimetres off the tracked
-                                    joints (docs/body-model.md, "Arms clear of the torso").
+                                    sleeve and the torso cloth under it both have room, and a
+                                    garment's upper sleeves also collide with the torso, so a
+                                    hanging sleeve stays out of it; the body mesh's arms then sit
+                                    up to a few centimetres off the tracked joints
+                                    (docs/body-model.md, "Arms clear of the torso"; docs/garments.md,
+                                    "Sleeves meet the torso").
                                     0: every ring centred on its bone (the paper). 0 or 1 */
   float arm_torso_clearance_m;   /* gap kept between an arm ring and the torso ring beside it,
                                     [0, 0.05] m; 0.01 (two layers of cloth at their 4 mm margin) */

@@ -221,7 +221,8 @@ class GarmentSim {
   // sleeve_meets_torso: the cloth nearest an upper arm, from kSleeveMeetsTorsoFrom to
   // kSleeveMeetsTorsoTo of the way from the shoulder joint to the elbow, also collides with the
   // torso. create() sets it when the tracked bodies keep their arms clear of the torso
-  // (BodyModelParams::tracked_arms_clear_torso), which leaves room for it between the two. Why:
+  // (BodyModelParams::tracked_arms_clear_torso) by more than twice the garment's collision margin
+  // at creation, which leaves room for it between the two. Why:
   // a hanging sleeve's inner side, meeting only the arm, fell into the torso beside it (Ges01's
   // worst frame: 12.9 mm P99, sleeve vertices up to 31 mm deep; docs/garments.md, "Sleeves meet
   // the torso"). Not the armpit end (the arm's junction ellipsoids overlap the torso's, cloth
