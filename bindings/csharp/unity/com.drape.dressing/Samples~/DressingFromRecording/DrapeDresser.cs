@@ -37,7 +37,7 @@ namespace Drape.Samples
         [Header("Body (optional)")]
         [Tooltip("Receives the body mesh; leave empty not to read the body.")]
         [SerializeField] private MeshFilter bodyMesh = null;
-        [Tooltip("Arms kept clear of the torso (the default): a hanging arm's rings move out of the torso so the sleeve and the torso cloth both have room, and the body's arms then sit up to a few centimetres off the tracked joints. Off: every ring on its bone, e.g. to overlay the body on the sensor's image (docs/body-model.md).")]
+        [Tooltip("Arms kept clear of the torso (the default): a hanging arm's rings move out of the torso so the sleeve and the torso cloth both have room and the upper sleeves also collide with the torso, and the body's arms then sit up to a few centimetres off the tracked joints. Off: every ring on its bone, e.g. to overlay the body on the sensor's image (docs/body-model.md).")]
         [SerializeField] private bool armsClearTorso = true;
 
         [Header("Space")]
