@@ -195,16 +195,16 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
   // hanging upper arm runs inside the torso's side, and the side panels under it, nearer the
   // arm's tube than the torso's, met only the arm and sank into the torso as it moved away.
   // (Not when the tracked bodies keep their rings on the bones: BodyModelParams.)
+  const BodyModelParams& tracked = body_rest.params();
   std::vector<RingPose> mask_rings = body_rest.rings();
-  if (body_rest.params().tracked_arms_clear_torso) {
+  if (tracked.tracked_arms_clear_torso) {
     Vec3 unused[2];
-    keepArmsOutOfTorso(body_rest, mask_rings, ArmClearance{body_rest.params().arm_torso_clearance_m, 1.0f}, unused);
+    keepArmsOutOfTorso(body_rest, mask_rings, ArmClearance{tracked.arm_torso_clearance_m, 1.0f}, unused);
   }
   // With the arms clear by more than two layers of cloth (this garment's margin each), the upper
   // arm's sleeve cloth meets the torso too (maskFor); closer, the two parts' inflated ellipsoids
   // overlap and would hold it between them (a clearance of 0: 574 particle-frames inside an
   // ellipsoid on Ges01's T-shirt and P99 stretch 19.6 %).
-  const BodyModelParams& tracked = body_rest.params();
   const bool sleeve_meets_torso =
       tracked.tracked_arms_clear_torso && tracked.arm_torso_clearance_m > 2.0f * params.collision_margin_m;
   g->masks_.resize(g->mesh_.positions.size());
