@@ -174,6 +174,7 @@ int run(int argc, char** argv) {
     drape_garment_desc gdesc;
     drape_garment_desc_init(&gdesc);
     gdesc.solver = opt.solver;
+    gdesc.cut = opt.garment_cut;
     if (opt.substeps != 0) cloth.substep_hz = 30.0f * static_cast<float>(opt.substeps);
     else if (opt.solver == DRAPE_SOLVER_MASS_SPRING) cloth.substep_hz = kMassSpringSubstepHz;
     if (opt.iterations != 0) cloth.iterations = opt.iterations;
@@ -219,7 +220,15 @@ int run(int argc, char** argv) {
   st.ring_points = desc.ring_points;
   st.proxy_rule = desc.proxy_rule;
   st.arm_clearance_m = desc.arms_clear_torso ? desc.arm_torso_clearance_m : -1.0;
-  st.garment_fit = desc.garment_fit;
+  st.garment_fit_by_kind = opt.garment_cut == DRAPE_GARMENT_CUT_BY_KIND;
+  if (garment != nullptr) {
+    // What the garment is cut for (its cut resolved by the library: by kind, or the context's).
+    drape_garment_stats gs0{};
+    gs0.struct_size = sizeof gs0;
+    if (drape_result r = drape_garment_get_stats(garment, &gs0))
+      return fail(kExitFailure, "drape_garment_get_stats failed: " + libraryReason(r));
+    st.garment_fit = gs0.cut;
+  }
   if (opt.backend == "opencl") {
     // OpenCL for the cloth; without a working device the library falls back to the CPU and says
     // why: the replay goes on and the stats record it (backend "cpu", backend_fallback).

@@ -221,9 +221,17 @@ bool parseOptions(int argc, const char* const* argv, Options& o, std::string& er
         return false;
       }
     } else if (name == "--garment-fit") {
-      if (!takeValue() || !parseChoice(name, value, "shape", DRAPE_GARMENT_FIT_SHAPE, "skeleton",
-                                       DRAPE_GARMENT_FIT_SKELETON, o.garment_fit, error))
+      if (!takeValue()) return false;
+      if (value == "by-kind") {
+        o.garment_fit = DRAPE_GARMENT_FIT_SHAPE;
+        o.garment_cut = DRAPE_GARMENT_CUT_BY_KIND;
+      } else if (parseChoice(name, value, "shape", DRAPE_GARMENT_FIT_SHAPE, "skeleton", DRAPE_GARMENT_FIT_SKELETON,
+                             o.garment_fit, error)) {
+        o.garment_cut = DRAPE_GARMENT_CUT_CONTEXT;
+      } else {
+        error = "--garment-fit '" + value + "' is not 'by-kind', 'shape' or 'skeleton'";
         return false;
+      }
     } else if (name == "--fidelity-every") {
       if (!takeValue()) return false;
       if (!parseUint(value, 0, 0xffffffffUL, o.fidelity_every)) {
@@ -431,9 +439,10 @@ std::string helpText() {
       "  --garment G           tshirt (default), longsleeve, skirt, dress, trousers, none (no cloth:\n"
       "                        push + update only), or PATH.obj (a garment mesh, e.g. from MakeHuman)\n"
       "  --particles N         template garment resolution, in [200, 200000] (default 2000)\n"
-      "  --garment-fit F       shape (default: the body shape's standard proportions) or skeleton\n"
-      "                        (once the bone lengths are calibrated, the garment is cut again for\n"
-      "                        this person's bones and torso)\n"
+      "  --garment-fit F       by-kind (default: trousers and long-sleeve tops as skeleton, the\n"
+      "                        others as shape), shape (the body shape's standard proportions) or\n"
+      "                        skeleton (once the bone lengths are calibrated, the garment is cut\n"
+      "                        again for this person's bones and torso)\n"
       "  --solver S            xpbd (default) or massspring (the paper's mass-spring; it needs\n"
       "                        ~3 kHz, so it runs at 2880 Hz unless --substeps is given)\n"
       "  --substeps N          cloth substeps per 1/30 s frame, in [1, 666]: substep_hz = 30 * N\n"

@@ -16,7 +16,10 @@ struct Options {
   uint32_t max_frames = 0;         // 0: every frame of the recording
   uint32_t ring_points = 0;        // 0: the library default
   int32_t proxy_rule = DRAPE_PROXY_RULE_DRAPE;
+  // --garment-fit: by-kind (default) = a SHAPE context and the garment's cut BY_KIND; shape /
+  // skeleton = that context fit, followed by the garment (cut CONTEXT).
   int32_t garment_fit = DRAPE_GARMENT_FIT_SHAPE;
+  int32_t garment_cut = DRAPE_GARMENT_CUT_BY_KIND;
   double arm_clearance_m = -1.0;   // --arm-clearance M: [0, 0.05] m; < 0: the library default
   bool arms_on_bones = false;      // --arm-clearance off: drape_context_desc.arms_clear_torso 0
   uint32_t fidelity_every = 10;    // measure proxy fidelity every N updated frames; 0: never

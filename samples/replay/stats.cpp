@@ -205,6 +205,7 @@ std::string statsJson(const ReplayStats& s) {
   w.key("edges").value(static_cast<int64_t>(s.stretch.edgeCount()));
   w.key("attached").value(s.attached);
   w.key("fit").value(s.garment_fit == DRAPE_GARMENT_FIT_SKELETON ? "skeleton" : "shape");
+  w.key("fit_by_kind").value(s.garment_fit_by_kind);
   w.key("refits").value(s.refits);
   w.key("frames_stepped").value(static_cast<uint32_t>(s.cloth_ms.size()));
   w.key("max_stretch").value(s.stretch.max());
@@ -283,8 +284,11 @@ std::string summaryText(const ReplayStats& s, const std::string& obj_dir, const 
         s.solver == DRAPE_SOLVER_MASS_SPRING ? "massspring" : "xpbd", s.substep_hz, passes.c_str(), s.particles,
         s.attached, s.garment_triangles);
     appendf(o, "fit         %s%s\n",
-            s.garment_fit != DRAPE_GARMENT_FIT_SKELETON ? "the body shape's standard proportions"
-                                                        : "the person's skeleton once calibrated (--garment-fit skeleton)",
+            s.garment_fit != DRAPE_GARMENT_FIT_SKELETON
+                ? (s.garment_fit_by_kind ? "the body shape's standard proportions (by its kind)"
+                                         : "the body shape's standard proportions")
+                : (s.garment_fit_by_kind ? "the person's skeleton once calibrated (by its kind: limbs to the wrists or ankles)"
+                                         : "the person's skeleton once calibrated (--garment-fit skeleton)"),
             s.garment_fit != DRAPE_GARMENT_FIT_SKELETON ? ""
             : s.refits > 0 ? (", cut again " + std::to_string(s.refits) + "x").c_str()
                            : ", no refit (proportions within 1 cm of the standard ones, or not calibrated)");

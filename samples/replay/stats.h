@@ -73,7 +73,8 @@ struct ReplayStats {
   uint32_t attached = 0;
   uint32_t teleport_resets = 0;    // stepped frames with drape_garment_stats.teleport_reset
   uint32_t nan_resets = 0;         // ... with nan_reset
-  int32_t garment_fit = DRAPE_GARMENT_FIT_SHAPE;
+  int32_t garment_fit = DRAPE_GARMENT_FIT_SHAPE;  // the garment's cut (drape_garment_stats.cut)
+  bool garment_fit_by_kind = false;               // chosen by its kind (--garment-fit by-kind)
   uint32_t refits = 0;             // drape_garment_stats.refits after the last step
   // Per stepped frame (drape_garment_get_stats after the step).
   std::vector<double> cloth_ms, integrate_ms, collide_ms, contacts, substeps;

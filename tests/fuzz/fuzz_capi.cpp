@@ -331,7 +331,7 @@ struct Machine {
     if (mode & 1) d.solver = static_cast<int32_t>(in.u8() % 3);
     if (mode & 2) d.area_density = in.inRange(0.0f, 10.0f);
     if (mode & 4) d.max_tethers = in.u8() % 10;
-    if (mode & 8) d.cut = static_cast<int32_t>(in.u8() % 4);  // 3 is out of range
+    if (mode & 8) d.cut = static_cast<int32_t>(in.u8() % 5);  // 4 is out of range
   }
 
   void addTemplate() {

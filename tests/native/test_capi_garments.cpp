@@ -279,7 +279,7 @@ TEST(CApiGarments, BadGarmentInputIsRejectedAndCreatesNothing) {
   d.solver = 5;
   EXPECT_FAILS(DRAPE_ERROR_OUT_OF_RANGE, "drape_context_add_garment_template",
                drape_context_add_garment_template(ctx.get(), &d, nullptr, nullptr, &g));
-  for (int32_t cut : {-1, 3, 0x7fffffff}) {
+  for (int32_t cut : {-1, 4, 0x7fffffff}) {
     drape_garment_desc_init(&d);
     d.cut = cut;
     EXPECT_FAILS(DRAPE_ERROR_OUT_OF_RANGE, "drape_context_add_garment_template",
@@ -354,6 +354,13 @@ uint32_t refitsOf(drape_garment* g) {
   return s.refits;
 }
 
+uint8_t cutOf(drape_garment* g) {
+  drape_garment_stats s;
+  s.struct_size = sizeof(s);
+  EXPECT_EQ(drape_garment_get_stats(g, &s), DRAPE_OK) << lastError();
+  return s.cut;
+}
+
 std::vector<drape_vec3> restOf(drape_garment* g) {
   uint32_t vertices = 0, indices = 0;
   EXPECT_EQ(drape_garment_get_mesh_size(g, &vertices, &indices), DRAPE_OK) << lastError();
@@ -398,6 +405,61 @@ TEST(CApiGarments, AGarmentsOwnCutOverridesTheContexts) {
   EXPECT_FALSE(same(legsRest, legsAfter)) << "the trousers cut again: a new rest shape";
   EXPECT_TRUE(same(keptRest, keptAfter)) << "the T-shirt cut for the shape keeps its rest shape";
   for (drape_garment* g : {top, legs, kept, follows}) EXPECT_TRUE(allFinite(snapshot(g)));
+}
+
+// DRAPE_GARMENT_CUT_BY_KIND, drape_garment_desc_init's default: trousers and long-sleeve templates
+// are cut for the skeleton (cut again at the calibration) in a context that cuts for the shape;
+// the T-shirt, skirt, dress and a caller's mesh follow the context. drape_garment_stats.cut says
+// which, from the moment the garment is added.
+TEST(CApiGarments, ByKindCutsTrousersAndLongSleevesForTheSkeleton) {
+  drape_garment_desc d;
+  ASSERT_OK(drape_garment_desc_init(&d));
+  EXPECT_EQ(d.cut, DRAPE_GARMENT_CUT_BY_KIND);
+  ContextPtr ctx = makeContext();  // garment_fit: the default, DRAPE_GARMENT_FIT_SHAPE
+  struct Case {
+    int32_t kind;
+    uint8_t cut;
+  };
+  const Case cases[] = {{DRAPE_GARMENT_TROUSERS, DRAPE_GARMENT_FIT_SKELETON},
+                        {DRAPE_GARMENT_LONG_SLEEVE, DRAPE_GARMENT_FIT_SKELETON},
+                        {DRAPE_GARMENT_TSHIRT, DRAPE_GARMENT_FIT_SHAPE},
+                        {DRAPE_GARMENT_SKIRT, DRAPE_GARMENT_FIT_SHAPE},
+                        {DRAPE_GARMENT_DRESS, DRAPE_GARMENT_FIT_SHAPE}};
+  std::vector<drape_garment*> garments;
+  for (const Case& c : cases) {
+    garments.push_back(addTemplateCut(ctx.get(), c.kind, DRAPE_GARMENT_CUT_BY_KIND));
+    ASSERT_NE(garments.back(), nullptr);
+    EXPECT_EQ(cutOf(garments.back()), c.cut) << "kind " << c.kind;
+  }
+  // A caller's mesh has no kind: it follows the context.
+  // (In front of the chest, as CallerMeshAndObjGarments places it.)
+  const drape_vec3 quad[4] = {{-0.1f, 1.1f, 2.3f}, {0.1f, 1.1f, 2.3f}, {0.1f, 1.3f, 2.3f}, {-0.1f, 1.3f, 2.3f}};
+  const uint32_t tris[6] = {0, 1, 2, 0, 2, 3};
+  drape_mesh_fit fit;
+  ASSERT_OK(drape_mesh_fit_init(&fit));
+  fit.unit_scale = 1.0f;
+  fit.facing = 1;
+  fit.source_floor_y_m = 0.0f;
+  fit.source_axis_z_m = 2.5f;
+  drape_garment* patch = nullptr;
+  ASSERT_OK(drape_context_add_garment_mesh(ctx.get(), quad, 4, tris, 6, &fit, &d, nullptr, &patch));
+  EXPECT_EQ(cutOf(patch), DRAPE_GARMENT_FIT_SHAPE);
+  for (int i = 0; i < 35; ++i) ASSERT_OK(pushAndStep(ctx.get(), i));
+  for (size_t k = 0; k < garments.size(); ++k) {
+    EXPECT_EQ(refitsOf(garments[k]), cases[k].cut == DRAPE_GARMENT_FIT_SKELETON ? 1u : 0u) << "kind " << cases[k].kind;
+    EXPECT_TRUE(allFinite(snapshot(garments[k])));
+  }
+  EXPECT_EQ(refitsOf(patch), 0u);
+  // In a context that cuts for the skeleton, BY_KIND cuts every garment for it.
+  drape_context_desc sd;
+  ASSERT_OK(drape_context_desc_init(&sd));
+  sd.garment_fit = DRAPE_GARMENT_FIT_SKELETON;
+  drape_context* raw = nullptr;
+  ASSERT_OK(drape_context_create(&sd, &raw));
+  ContextPtr skeletonCtx(raw);
+  drape_garment* top = addTemplateCut(skeletonCtx.get(), DRAPE_GARMENT_TSHIRT, DRAPE_GARMENT_CUT_BY_KIND);
+  ASSERT_NE(top, nullptr);
+  EXPECT_EQ(cutOf(top), DRAPE_GARMENT_FIT_SKELETON);
 }
 
 TEST(CApiGarments, CallerMeshAndObjGarments) {

@@ -96,7 +96,7 @@ namespace Drape.Tests
             Assert.Equal(0.2f, d.AreaDensity, 1e-6f);
             Assert.Equal(2u, d.MaxTethers);
             Assert.Equal(0.5f, d.DressTimeS);
-            Assert.Equal(GarmentCut.Context, d.Cut);
+            Assert.Equal(GarmentCut.ByKind, d.Cut);
 
             GarmentTemplate t = GarmentTemplate.CreateDefault();
             Assert.Equal(24u, t.StructSize);
@@ -270,6 +270,25 @@ namespace Drape.Tests
             Assert.Equal(before, again);
         }
 
+        [Fact]
+        public void ByKind_CutsTrousersAndLongSleevesForTheSkeleton()
+        {
+            // GarmentCut.ByKind, the default: trousers and long sleeves are cut for the person's skeleton (cut again
+            // at the calibration) in a context that cuts for the shape; the T-shirt follows the context.
+            Assert.Equal(GarmentCut.ByKind, GarmentDesc.CreateDefault().Cut);
+            using var ctx = new Context();
+            using Garment trousers = ctx.AddGarment(Small(GarmentKind.Trousers));
+            using Garment sleeves = ctx.AddGarment(Small(GarmentKind.LongSleeve));
+            using Garment top = ctx.AddGarment(Small());
+            Assert.Equal(GarmentFit.Skeleton, trousers.Stats.CutFit);
+            Assert.Equal(GarmentFit.Skeleton, sleeves.Stats.CutFit);
+            Assert.Equal(GarmentFit.Shape, top.Stats.CutFit);
+            StepFrames(ctx, 31);
+            Assert.Equal(1u, trousers.Stats.Refits);
+            Assert.Equal(1u, sleeves.Stats.Refits);
+            Assert.Equal(0u, top.Stats.Refits);
+        }
+
         [Theory]
         [InlineData(GarmentKind.TShirt)]
         [InlineData(GarmentKind.LongSleeve)]
@@ -369,7 +388,7 @@ namespace Drape.Tests
             d.AreaDensity = float.NaN;
             Assert.Equal(ResultCode.NonFinite, Assert.Throws<DrapeException>(() => ctx.AddGarment(Small(), d)).Code);
             d = GarmentDesc.CreateDefault();
-            d.Cut = (GarmentCut)3;
+            d.Cut = (GarmentCut)4;
             e = Assert.Throws<DrapeException>(() => ctx.AddGarment(Small(), d));
             Assert.Equal(ResultCode.OutOfRange, e.Code);
             Assert.Contains("cut", e.NativeMessage);

@@ -205,7 +205,7 @@ namespace Drape.Tests
         public void GarmentStats_Is104() => AssertLayout<GarmentStats>(104,
             ("StructSize", 0), ("Particles", 4), ("Attached", 8), ("Substeps", 12), ("BlendFrames", 16), ("Contacts", 20),
             ("SweptCatches", 24), ("Escapes", 28), ("Steps", 32), ("TeleportReset", 40), ("NanReset", 41),
-            ("Reserved0", 42), ("Reserved1", 43), ("Refits", 44), ("StepMs", 48), ("CollideMs", 56),
+            ("Cut", 42), ("Reserved1", 43), ("Refits", 44), ("StepMs", 48), ("CollideMs", 56),
             ("IntegrateMs", 64), ("DeviceUploadMs", 72), ("DeviceKernelMs", 80), ("DeviceReadbackMs", 88),
             ("DeviceHostMs", 96));
 

@@ -90,7 +90,8 @@ namespace Drape
     }
 
     /// <summary>drape_garment_fit: what proportions garments are cut for (those whose
-    /// <see cref="GarmentDesc.Cut"/> is <see cref="GarmentCut.Context"/>, the default).</summary>
+    /// <see cref="GarmentDesc.Cut"/> is <see cref="GarmentCut.Context"/>, and by default every garment but
+    /// trousers and long-sleeve templates: <see cref="GarmentCut.ByKind"/>).</summary>
     public enum GarmentFit : int
     {
         /// <summary>DRAPE_GARMENT_FIT_SHAPE: the body shape's standard proportions only. The default.</summary>
@@ -105,13 +106,19 @@ namespace Drape
     /// <summary>drape_garment_cut: what proportions one garment is cut for (GarmentDesc.Cut).</summary>
     public enum GarmentCut : int
     {
-        /// <summary>DRAPE_GARMENT_CUT_CONTEXT: as the context's <see cref="ContextDesc.GarmentFit"/>. The default.</summary>
+        /// <summary>DRAPE_GARMENT_CUT_CONTEXT: as the context's <see cref="ContextDesc.GarmentFit"/> (a zero-filled
+        /// desc).</summary>
         Context = 0,
         /// <summary>DRAPE_GARMENT_CUT_SHAPE: the body shape's standard proportions, whatever the context's choice.</summary>
         Shape = 1,
         /// <summary>DRAPE_GARMENT_CUT_SKELETON: the tracked person's once the tracker has calibrated, whatever the
         /// context's choice (e.g. trousers on Kinect data beside a top cut for the shape).</summary>
         Skeleton = 2,
+        /// <summary>DRAPE_GARMENT_CUT_BY_KIND: trousers and long-sleeve templates as <see cref="Skeleton"/>, every
+        /// other garment as <see cref="Context"/>: legs and sleeves that reach the ankles and wrists stay round
+        /// the person's limbs only when cut to their lengths, the shorter garments stretch less on the shape's
+        /// cut (docs/garments.md, "Cut by kind"). The default (<see cref="GarmentDesc.CreateDefault"/>).</summary>
+        ByKind = 3,
     }
 
     /// <summary>drape_sex.</summary>
@@ -516,7 +523,8 @@ namespace Drape
         /// <summary>dress_time_s: settling on the rest pose when added, [0, 10]; default 0.5.</summary>
         public float DressTimeS;
         /// <summary>cut (int32_t in C): what proportions this garment is cut for; default
-        /// <see cref="GarmentCut.Context"/> (the context's <see cref="ContextDesc.GarmentFit"/>).</summary>
+        /// <see cref="GarmentCut.ByKind"/> (trousers and long sleeves for the person's skeleton, the rest as the
+        /// context's <see cref="ContextDesc.GarmentFit"/>); <see cref="GarmentStats.Cut"/> says what it got.</summary>
         public GarmentCut Cut;
 
         /// <summary>The library's defaults (drape_garment_desc_init).</summary>
@@ -715,13 +723,17 @@ namespace Drape
         public byte TeleportReset;
         /// <summary>nan_reset (uint8_t): 1 if the last step had to restore the garment (please report).</summary>
         public byte NanReset;
-        /// <summary>reserved0.</summary>
-        public byte Reserved0;
+        /// <summary>cut (uint8_t): what the garment is cut for, its desc's <see cref="GarmentDesc.Cut"/> resolved,
+        /// as a <see cref="GarmentFit"/> value (<see cref="CutFit"/>).</summary>
+        public byte Cut;
         /// <summary>reserved1.</summary>
         public byte Reserved1;
         /// <summary>refits: times the garment was cut again (a body shape change, the skeleton's calibration:
         /// <see cref="Drape.GarmentFit"/>); its rest shape changes then, nothing else.</summary>
         public uint Refits;
+        /// <summary><see cref="Cut"/> as a <see cref="GarmentFit"/> (<see cref="GarmentFit.Skeleton"/>: cut again for
+        /// the person once the tracker calibrates).</summary>
+        public GarmentFit CutFit => (GarmentFit)Cut;
         /// <summary>step_ms: wall time of the garment's last step.</summary>
         public double StepMs;
         /// <summary>collide_ms: of which ellipsoid collision; 0 on the OpenCL backend, where collision

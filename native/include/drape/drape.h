@@ -434,13 +434,19 @@ typedef enum drape_contact_response {
 
 /* What proportions one garment is cut for (drape_garment_desc.cut): the context's choice
  * (drape_context_desc.garment_fit) or its own, so that one person can wear a top cut for the body
- * shape and trousers cut for their skeleton (on the shared Kinect takes the skeleton cut keeps
- * trousers on the legs; on the CMU mocap takes it sinks garments deeper into the body:
- * docs/garments.md, "One garment's cut"). */
+ * shape and trousers cut for their skeleton (docs/garments.md, "One garment's cut" and "Cut by
+ * kind"). drape_garment_stats.cut says what a garment got. */
 typedef enum drape_garment_cut {
-  DRAPE_GARMENT_CUT_CONTEXT = 0,  /* as drape_context_desc.garment_fit says (default) */
+  DRAPE_GARMENT_CUT_CONTEXT = 0,  /* as drape_context_desc.garment_fit says (a zero-filled desc) */
   DRAPE_GARMENT_CUT_SHAPE = 1,    /* as DRAPE_GARMENT_FIT_SHAPE, whatever the context's choice */
   DRAPE_GARMENT_CUT_SKELETON = 2, /* as DRAPE_GARMENT_FIT_SKELETON, whatever the context's choice */
+  /* Trousers and long-sleeve templates as DRAPE_GARMENT_CUT_SKELETON, every other garment (T-shirt,
+   * skirt and dress templates, OBJ and mesh garments) as DRAPE_GARMENT_CUT_CONTEXT. Why: legs and
+   * sleeves that reach the ankles and wrists stay round the person's limbs only when cut to the
+   * person's limb lengths (on the shared Kinect takes the shape's trousers hang past the feet in
+   * every frame, on the CMU takes the long sleeves past the hands), while the shorter garments keep
+   * less stretch on the shape's cut. Default (drape_garment_desc_init). */
+  DRAPE_GARMENT_CUT_BY_KIND = 3,
   DRAPE_GARMENT_CUT_FORCE32 = 0x7fffffff
 } drape_garment_cut;
 
@@ -451,8 +457,8 @@ typedef struct drape_garment_desc {
   float area_density;     /* kg/m^2, (0, 10]; 0.2 (a light cotton shirt) */
   uint32_t max_tethers;   /* long-range attachments per particle, [0, 8]; 2 */
   float dress_time_s;     /* settling on the rest pose when added, [0, 10]; 0.5 */
-  int32_t cut;            /* drape_garment_cut; default DRAPE_GARMENT_CUT_CONTEXT (0: the former
-                             `reserved` field, so older callers keep their behaviour) */
+  int32_t cut;            /* drape_garment_cut; default DRAPE_GARMENT_CUT_BY_KIND (the field was
+                             `reserved` before: a zero-filled desc gets DRAPE_GARMENT_CUT_CONTEXT) */
 } drape_garment_desc;
 
 DRAPE_API drape_result DRAPE_CALL drape_garment_desc_init(drape_garment_desc* desc);
@@ -639,7 +645,10 @@ typedef struct drape_garment_stats {
   uint64_t steps;           /* steps so far */
   uint8_t teleport_reset;   /* 1 if the last step carried the garment across a teleport */
   uint8_t nan_reset;        /* 1 if the last step had to restore the garment (please report) */
-  uint8_t reserved0, reserved1;
+  uint8_t cut;              /* what the garment is cut for, its desc's cut resolved: a
+                               drape_garment_fit (DRAPE_GARMENT_FIT_SKELETON: recut for the person
+                               once the tracker calibrates) */
+  uint8_t reserved1;
   uint32_t refits;          /* times the garment was cut again (a body shape change, the skeleton's
                                calibration: drape_garment_fit); its rest shape
                                (drape_garment_read_rest_positions) changes then, nothing else */

@@ -169,7 +169,7 @@ drape_result readCommon(const char* fn, const drape_garment_desc* desc, const dr
   k.range(w, "area_density", d.area_density, 1e-6f, 10.0f);
   k.range(w, "max_tethers", static_cast<float>(d.max_tethers), 0.0f, 8.0f);
   k.range(w, "dress_time_s", d.dress_time_s, 0.0f, 10.0f);
-  k.range(w, "cut", static_cast<float>(d.cut), 0.0f, 2.0f);
+  k.range(w, "cut", static_cast<float>(d.cut), 0.0f, 3.0f);
   if (drape_result r = k.done(fn)) return r;
   drape_cloth_params c;
   drape_cloth_params_init(&c);
@@ -238,7 +238,7 @@ drape_result adoptCreated(const char* fn, Context& ctx, Context::RestCut cut, st
 drape_result adopt(const char* fn, Context& ctx, const drape::GarmentMesh& mesh, const drape_garment_desc& d,
                    const drape::GarmentSimParams& sim, drape_garment** out, bool cut_from_dressed) {
   std::string err;
-  const Context::RestCut cut = ctx.cutFor(d.cut);
+  const Context::RestCut cut = ctx.cutFor(d.cut, /*limbs_must_fit=*/false);
   auto g = GarmentSim::create(mesh, topologyFrom(d), static_cast<drape::ClothSolverKind>(d.solver), sim,
                               d.dress_time_s, ctx.restBody(cut), ctx.restEllipsoids(cut), ctx.restEllipsoidGroups(cut),
                               err, cut_from_dressed);
@@ -251,7 +251,7 @@ drape_result addFitted(const char* fn, Context& ctx, const drape::ObjMesh& obj, 
   if (drape_result r = toFitParams(fn, fit, fp)) return r;
   drape::GarmentMesh mesh;
   std::string err;
-  if (!drape::fitObjGarment(obj, fp, ctx.restBody(ctx.cutFor(d.cut)), mesh, err))
+  if (!drape::fitObjGarment(obj, fp, ctx.restBody(ctx.cutFor(d.cut, /*limbs_must_fit=*/false)), mesh, err))
     return fail(DRAPE_ERROR_INVALID_ARGUMENT, std::string(fn) + ": " + err);
   return adopt(fn, ctx, mesh, d, sim, out, /*cut_from_dressed=*/true);
 }
@@ -276,6 +276,7 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_desc_init(drape_garment_desc* de
   desc->area_density = t.area_density;
   desc->max_tethers = static_cast<uint32_t>(t.max_tethers_per_particle);
   desc->dress_time_s = 0.5f;
+  desc->cut = DRAPE_GARMENT_CUT_BY_KIND;
   return DRAPE_OK;
 }
 
@@ -347,7 +348,9 @@ DRAPE_API drape_result DRAPE_CALL drape_context_add_garment_template(drape_conte
     tp.ease_m = t.ease_m;
     tp.length_scale = t.length_scale;
     std::string err;
-    const Context::RestCut cut = ctx->cutFor(d.cut);
+    // Trousers and long sleeves reach the ankles and wrists (drape_garment_cut BY_KIND).
+    const bool limbs_must_fit = tp.kind == drape::GarmentKind::Trousers || tp.kind == drape::GarmentKind::LongSleeve;
+    const Context::RestCut cut = ctx->cutFor(d.cut, limbs_must_fit);
     auto g = GarmentSim::createTemplate(tp, topologyFrom(d), static_cast<drape::ClothSolverKind>(d.solver), sim,
                                         d.dress_time_s, ctx->restBody(cut), ctx->restEllipsoids(cut),
                                         ctx->restEllipsoidGroups(cut), err);
@@ -569,6 +572,9 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_get_stats(drape_garment* handle,
     o.teleport_reset = s.teleport_reset ? 1 : 0;
     o.nan_reset = s.nan_reset ? 1 : 0;
     o.refits = garment->refits();
+    o.cut = static_cast<Context*>(garment->api_owner)->cutOf(*garment) == Context::kCutSkeleton
+                ? static_cast<uint8_t>(DRAPE_GARMENT_FIT_SKELETON)
+                : static_cast<uint8_t>(DRAPE_GARMENT_FIT_SHAPE);
     o.step_ms = s.total_ms;
     o.collide_ms = s.collide_ms;
     o.integrate_ms = s.total_ms - s.collide_ms;

@@ -389,9 +389,10 @@ FidelityReport Context::measureFidelity() {
 
 namespace drape {
 
-Context::RestCut Context::cutFor(int32_t garment_cut) const {
+Context::RestCut Context::cutFor(int32_t garment_cut, bool limbs_must_fit) const {
   if (garment_cut == DRAPE_GARMENT_CUT_SHAPE) return kCutShape;
   if (garment_cut == DRAPE_GARMENT_CUT_SKELETON) return kCutSkeleton;
+  if (garment_cut == DRAPE_GARMENT_CUT_BY_KIND && limbs_must_fit) return kCutSkeleton;
   return contextCut();
 }
 
@@ -556,12 +557,16 @@ drape_result Context::stepContexts(Context* const* contexts, size_t count, float
   return result;
 }
 
+Context::RestCut Context::cutOf(const GarmentSim& garment) const {
+  for (size_t i = 0; i < garments_.size(); ++i)
+    if (garments_[i].get() == &garment) return garmentCuts_[i];
+  return contextCut();
+}
+
 GarmentAccuracy Context::measureGarment(const GarmentSim& garment) {
   if (!updated_) {
     // Before the first update: on the rest body the garment was cut on.
-    RestCut cut = contextCut();
-    for (size_t i = 0; i < garments_.size(); ++i)
-      if (garments_[i].get() == &garment) cut = garmentCuts_[i];
+    const RestCut cut = cutOf(garment);
     return garment.measure(restEllipsoids(cut), nullptr, &restBody(cut));
   }
   refreshBvh();

@@ -49,8 +49,12 @@ class Context {
   // Garments. What proportions a garment is cut for (its RestCut): the shape's standard ones, or
   // the person's bones once the tracker has calibrated them (before that, the shape's too).
   enum RestCut : int { kCutShape = 0, kCutSkeleton = 1 };
-  // A garment desc's cut (drape_garment_cut, validated) as a RestCut: CONTEXT follows garment_fit.
-  RestCut cutFor(int32_t garment_cut) const;
+  // A garment desc's cut (drape_garment_cut, validated) as a RestCut: CONTEXT follows garment_fit;
+  // BY_KIND is the skeleton's for a garment whose limbs must fit (limbs_must_fit: trousers and
+  // long-sleeve templates), else CONTEXT.
+  RestCut cutFor(int32_t garment_cut, bool limbs_must_fit) const;
+  // The cut a garment of this context was made for (contextCut() for one that is not).
+  RestCut cutOf(const GarmentSim& garment) const;
   RestCut contextCut() const {
     return desc_.garment_fit == DRAPE_GARMENT_FIT_SKELETON ? kCutSkeleton : kCutShape;
   }

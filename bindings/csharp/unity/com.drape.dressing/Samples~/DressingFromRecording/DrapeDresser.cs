@@ -27,8 +27,8 @@ namespace Drape.Samples
         [SerializeField] private GarmentKind garment = GarmentKind.TShirt;
         [Tooltip("Cloth particles (0: the template's default, 2 000).")]
         [SerializeField] private int particles = 0;
-        [Tooltip("What the garment is cut for: Context (the context's GarmentFit, the shape's standard proportions by default), Shape, or Skeleton (cut again for the person's bones once the tracker has calibrated: on the Kinect takes this keeps trousers on the legs; docs/garments.md).")]
-        [SerializeField] private GarmentCut cut = GarmentCut.Context;
+        [Tooltip("What the garment is cut for: ByKind (the default: trousers and long sleeves cut again for the person's bones once the tracker has calibrated, so legs and sleeves end at the ankles and wrists; other garments as the context's GarmentFit), Context (the context's GarmentFit, the shape's standard proportions by default), Shape, or Skeleton (docs/garments.md, \"Cut by kind\").")]
+        [SerializeField] private GarmentCut cut = GarmentCut.ByKind;
         [Tooltip("Receives the garment mesh (its sharedMesh is replaced).")]
         [SerializeField] private MeshFilter garmentMesh = null;
         [Tooltip("Normals from Drape (true) or Mesh.RecalculateNormals (false).")]
