@@ -216,6 +216,12 @@ struct Person {
   }
 };
 
+// Steps from the calibration's to the one that swaps the new cut in: the dressing's frames
+// (GarmentSim::create: 0.5 s at 30 Hz, the default dress time), kRecutFramesPerStep a step, then
+// the swap.
+constexpr int kDressFrames = 15;
+constexpr int kRecutSteps = (kDressFrames + Context::kRecutFramesPerStep - 1) / Context::kRecutFramesPerStep + 1;
+
 TEST(GarmentFit, CalibrationRecutsTheGarmentsForThePersonsBones) {
   for (GarmentKind kind : {GarmentKind::Trousers, GarmentKind::TShirt}) {
     Person fitted(otherPerson(), kind, DRAPE_GARMENT_FIT_SKELETON);
@@ -230,8 +236,18 @@ TEST(GarmentFit, CalibrationRecutsTheGarmentsForThePersonsBones) {
       standard.step();
     }
     EXPECT_EQ(fitted.garment->refits(), 0u) << "not calibrated yet";
-    fitted.step();  // the 30th push calibrates
+    fitted.step();  // the 30th push calibrates: the new cut is made, then dressed over the next steps
     standard.step();
+    EXPECT_TRUE(fitted.ctx->recutPending());
+    EXPECT_FALSE(standard.ctx->recutPending());
+    int steps = 0;
+    while (fitted.garment->refits() == 0 && steps < 3 * kRecutSteps) {
+      fitted.step();
+      standard.step();
+      ++steps;
+    }
+    EXPECT_EQ(steps, kRecutSteps) << "the old cut steps on while the new one is dressed, then they swap";
+    EXPECT_FALSE(fitted.ctx->recutPending());
     EXPECT_EQ(fitted.garment->refits(), 1u);
     EXPECT_EQ(standard.garment->refits(), 0u);
     EXPECT_EQ(&fitted.ctx->garment(0), fitted.garment) << "the same garment object (the C ABI handle)";
@@ -276,7 +292,7 @@ TEST(GarmentFit, TheStandardProportionsKeepTheGarmentAsItIs) {
 
 TEST(GarmentFit, AGarmentAddedAfterCalibrationIsCutForThePersonAtOnce) {
   Person early(otherPerson(), GarmentKind::Trousers, DRAPE_GARMENT_FIT_SKELETON);
-  for (int f = 0; f < 35; ++f) early.step();
+  for (int f = 0; f < 30 + kRecutSteps; ++f) early.step();
   ASSERT_EQ(early.garment->refits(), 1u);
   std::string err;
   GarmentSim* late = test::addTemplate(*early.ctx, GarmentKind::Trousers, 800, ClothSolverKind::Xpbd, GarmentSimParams{}, err);
@@ -286,6 +302,53 @@ TEST(GarmentFit, AGarmentAddedAfterCalibrationIsCutForThePersonAtOnce) {
   EXPECT_EQ(late->refits(), 0u) << "made on the person's rest body: nothing to refit";
   EXPECT_EQ(early.garment->refits(), 1u);
   EXPECT_EQ(inside, 0u);
+}
+
+// While a recut is being dressed (Context::Recut) the host goes on: a garment removed then takes
+// its replacement with it and the others still swap; parameters set then are the replacement's
+// too; a body shape change cancels the recut and refits every garment at once (on the skeleton's
+// rest body of the new shape, with the calibrated bones).
+TEST(GarmentFit, ARecutBeingDressedFollowsTheHost) {
+  std::string err;
+  {
+    Person p(otherPerson(), GarmentKind::Trousers, DRAPE_GARMENT_FIT_SKELETON);
+    GarmentSim* top = test::addTemplate(*p.ctx, GarmentKind::TShirt, 600, ClothSolverKind::Xpbd, GarmentSimParams{}, err);
+    ASSERT_NE(top, nullptr) << err;
+    for (int f = 0; f < 32; ++f) p.step();
+    ASSERT_TRUE(p.ctx->recutPending());
+    ASSERT_TRUE(p.ctx->removeGarment(p.garment));
+    p.garment = top;
+    for (int f = 0; f < kRecutSteps; ++f) p.step();
+    EXPECT_FALSE(p.ctx->recutPending());
+    EXPECT_EQ(top->refits(), 1u);
+    EXPECT_EQ(p.ctx->garmentCount(), 1u);
+    for (size_t i = 0; i < top->particleCount(); ++i) ASSERT_TRUE(top->positions()[i].allFinite());
+  }
+  {
+    Person p(otherPerson(), GarmentKind::Trousers, DRAPE_GARMENT_FIT_SKELETON);
+    for (int f = 0; f < 32; ++f) p.step();
+    ASSERT_TRUE(p.ctx->recutPending());
+    GarmentSimParams q = p.garment->params();
+    q.collision_margin_m = 0.006f;
+    ASSERT_TRUE(p.garment->setParams(q, err)) << err;
+    for (int f = 0; f < kRecutSteps; ++f) p.step();
+    ASSERT_EQ(p.garment->refits(), 1u);
+    EXPECT_EQ(p.garment->params().collision_margin_m, 0.006f) << "the host's parameters, set while it was dressed";
+  }
+  {
+    Person p(otherPerson(), GarmentKind::Trousers, DRAPE_GARMENT_FIT_SKELETON);
+    for (int f = 0; f < 32; ++f) p.step();
+    ASSERT_TRUE(p.ctx->recutPending());
+    BodyShapeInput in;
+    in.height_m = 1.80f;
+    in.weight_kg = 80.0f;
+    ASSERT_EQ(p.ctx->setShape(in, err), DRAPE_OK) << err;
+    EXPECT_FALSE(p.ctx->recutPending());
+    EXPECT_EQ(p.garment->refits(), 1u) << "refitted to the new shape at once";
+    for (int f = 0; f < 2 * kRecutSteps; ++f) p.step();
+    EXPECT_EQ(p.garment->refits(), 1u) << "no recut for the old shape swapped in later";
+    for (size_t i = 0; i < p.garment->particleCount(); ++i) ASSERT_TRUE(p.garment->positions()[i].allFinite());
+  }
 }
 
 // Ges01's calibrated skeleton (the bundled Kinect take): the T-shirt made again there with the

@@ -242,7 +242,11 @@ namespace Drape.Tests
             {
                 StepFrames(fitted, 29);
                 Assert.Equal(0u, f.Stats.Refits);
+                // The 30th frame calibrates; the new cut is dressed two frames a step beside the old one
+                // (15 frames), then swapped in: refitted by the 40th step.
                 StepFrames(fitted, 2, 29);
+                Assert.Equal(0u, f.Stats.Refits);
+                StepFrames(fitted, 10, 31);
                 Assert.Equal(1u, f.Stats.Refits);
                 ReadAndCheck(f);
             }
@@ -255,7 +259,7 @@ namespace Drape.Tests
                 skeleton.Cut = GarmentCut.Skeleton;
                 using Garment top = mixed.AddGarment(Small());
                 using Garment legs = mixed.AddGarment(Small(), skeleton);
-                StepFrames(mixed, 31);
+                StepFrames(mixed, 45);  // calibrated at the 30th, the new cut swapped in at the 39th
                 Assert.Equal(0u, top.Stats.Refits);
                 Assert.Equal(1u, legs.Stats.Refits);
                 ReadAndCheck(legs);
@@ -283,7 +287,7 @@ namespace Drape.Tests
             Assert.Equal(GarmentFit.Skeleton, trousers.Stats.CutFit);
             Assert.Equal(GarmentFit.Skeleton, sleeves.Stats.CutFit);
             Assert.Equal(GarmentFit.Shape, top.Stats.CutFit);
-            StepFrames(ctx, 31);
+            StepFrames(ctx, 45);  // calibrated at the 30th, the new cuts swapped in at the 39th
             Assert.Equal(1u, trousers.Stats.Refits);
             Assert.Equal(1u, sleeves.Stats.Refits);
             Assert.Equal(0u, top.Stats.Refits);

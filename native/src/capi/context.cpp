@@ -133,8 +133,13 @@ drape_result Context::setShape(const BodyShapeInput& in, std::string& err) {
   // Garments are refitted to the new body (GarmentSim::refitted, docs/garments.md "Body shape
   // changes"): all of them or, when one cannot be dressed on it, none and the old shape back.
   // The same measurements again (a host that sets the shape every frame) change nothing.
-  if (before.m != shape_.m && !refitGarments(err, /*remake_templates=*/false)) {
+  // A recut still dressing (the skeleton's calibration) was for the old shape: this refit covers
+  // its garments too, on the skeleton's rest body of the new shape.
+  const bool recutting = before.m != shape_.m && !recuts_.empty();
+  if (before.m != shape_.m) recuts_.clear();
+  if (before.m != shape_.m && !refitGarments(err)) {
     useShape(before);
+    if (recutting) restoreFitBefore();  // the skeleton's garments stay on the cut they have
     err += "; the previous shape is kept";
     return DRAPE_ERROR_INVALID_ARGUMENT;
   }
@@ -165,35 +170,80 @@ void Context::fitGarmentsToSkeleton() {
   for (int j = 0; j < kJointCount; ++j)
     moved = std::max(moved, (fitted.position[static_cast<size_t>(j)] - current.position[static_cast<size_t>(j)]).norm());
   if (!(moved >= kRefitBelowM)) return;  // this person has the proportions the garments were cut for
-  const bool before = fitBones_;
-  const std::array<float, kBoneCount> beforeBones = fittedBones_;
-  const SkeletonPose beforeTorso = fittedTorso_;
+  recuts_.clear();  // an earlier calibration's recut still dressing: this one's replaces it
+  recutFitBefore_ = fitBones_;
+  recutBonesBefore_ = fittedBones_;
+  recutTorsoBefore_ = fittedTorso_;
   fitBones_ = true;
   fittedBones_ = tracker_.boneLengths();
   fittedTorso_ = torso;
   rest_[kCutSkeleton].body.reset();
-  std::string err;
-  const RestCut only = kCutSkeleton;
-  size_t refitted = 0;
-  if (!refitGarments(err, /*remake_templates=*/true, &only, &refitted)) {
-    fitBones_ = before;
-    fittedBones_ = beforeBones;
-    fittedTorso_ = beforeTorso;
-    rest_[kCutSkeleton].body.reset();
-    return;
+  // The replacements, made now and dressed over the next steps (advanceRecuts): all of them or,
+  // when one cannot be made on the new body, none.
+  for (size_t i = 0; i < garments_.size(); ++i) {
+    if (garmentCuts_[i] != kCutSkeleton) continue;
+    Recut r;
+    r.garment = garments_[i].get();
+    std::string why;
+    r.fresh = r.garment->refitted(restBody(kCutSkeleton), restEllipsoids(kCutSkeleton),
+                                  restEllipsoidGroups(kCutSkeleton), why, /*remake_template=*/true, &r.dressing);
+    if (!r.fresh) {
+      recuts_.clear();
+      restoreFitBefore();
+      return;
+    }
+    recuts_.push_back(std::move(r));
   }
   // The adaptive pipeline's ellipsoid bounds come from the context's own cut's rest body.
   if (contextCut() == kCutSkeleton) proxyBounds_.clear();
-  if (refitted > 0) wakeAll();
 }
 
-bool Context::refitGarments(std::string& err, bool remake_templates, const RestCut* only, size_t* refitted) {
+void Context::restoreFitBefore() {
+  fitBones_ = recutFitBefore_;
+  fittedBones_ = recutBonesBefore_;
+  fittedTorso_ = recutTorsoBefore_;
+  rest_[kCutSkeleton].body.reset();
+  if (contextCut() == kCutSkeleton) proxyBounds_.clear();
+}
+
+void Context::advanceRecuts() {
+  if (recuts_.empty()) return;
+  bool dressed = true;
+  for (const Recut& r : recuts_) dressed = dressed && r.dressing.finished;
+  if (!dressed) {
+    for (Recut& r : recuts_) {
+      std::string why;
+      if (!r.fresh->dress(r.dressing, kRecutFramesPerStep, why)) {
+        // Every garment stays as it was, on the previous rest body, until the next calibration.
+        recuts_.clear();
+        restoreFitBefore();
+        return;
+      }
+    }
+    return;
+  }
+  ReachParams rp;
+  rp.margin_m = options_.reach_margin_m;
+  for (Recut& r : recuts_) {
+    GarmentSim& g = *r.garment;
+    std::string unused;
+    r.fresh->setParams(g.params(), unused);  // the host's parameters of now (validated when set)
+    g.replaceWith(std::move(*r.fresh));
+    adaptive_.removeGarment(&g);
+    adaptive_.addGarment(&g, garmentReach(g, rp));
+    applyBackend(g);
+  }
+  recuts_.clear();
+  reachDirty_ = true;
+  wakeAll();
+}
+
+bool Context::refitGarments(std::string& err) {
   std::vector<std::unique_ptr<GarmentSim>> refits(garments_.size());
   for (size_t i = 0; i < garments_.size(); ++i) {
     const RestCut cut = garmentCuts_[i];
-    if (only && cut != *only) continue;
     std::string why;
-    refits[i] = garments_[i]->refitted(restBody(cut), restEllipsoids(cut), restEllipsoidGroups(cut), why, remake_templates);
+    refits[i] = garments_[i]->refitted(restBody(cut), restEllipsoids(cut), restEllipsoidGroups(cut), why);
     if (!refits[i]) {
       err = "garment " + std::to_string(i) + " could not be dressed on the new body (" + why + ")";
       return false;
@@ -201,17 +251,13 @@ bool Context::refitGarments(std::string& err, bool remake_templates, const RestC
   }
   ReachParams rp;
   rp.margin_m = options_.reach_margin_m;
-  size_t count = 0;
   for (size_t i = 0; i < garments_.size(); ++i) {
-    if (!refits[i]) continue;
     GarmentSim& g = *garments_[i];
     g.replaceWith(std::move(*refits[i]));
     adaptive_.removeGarment(&g);
     adaptive_.addGarment(&g, garmentReach(g, rp));
     applyBackend(g);
-    ++count;
   }
-  if (refitted) *refitted = count;
   return true;
 }
 
@@ -436,6 +482,9 @@ GarmentSim* Context::adoptGarment(std::unique_ptr<GarmentSim> garment, RestCut c
 bool Context::removeGarment(const GarmentSim* garment) {
   for (auto it = garments_.begin(); it != garments_.end(); ++it) {
     if (it->get() == garment) {
+      // Its replacement, if a recut is dressing one, goes with it.
+      recuts_.erase(std::remove_if(recuts_.begin(), recuts_.end(), [&](const Recut& r) { return r.garment == garment; }),
+                    recuts_.end());
       adaptive_.removeGarment(garment);
       reachDirty_ = true;
       garmentCuts_.erase(garmentCuts_.begin() + (it - garments_.begin()));
@@ -469,8 +518,10 @@ drape_result Context::checkStep(float dt, std::string& err) const {
 
 drape_result Context::beginStep(float dt, std::string& err) {
   if (drape_result r = update(err)) return r;
-  if (tracker_.calibrated() && tracker_.calibrationCount() != fittedCalibration_) fitGarmentsToSkeleton();
   stepT0_ = Clock::now();
+  // A recut dresses from the step after the calibration's, which makes the replacements.
+  advanceRecuts();
+  if (tracker_.calibrated() && tracker_.calibrationCount() != fittedCalibration_) fitGarmentsToSkeleton();
   // Woken or new garments, or new options, since the frame's ellipsoids were built.
   if (reachDirty_ && updated_) buildProxies(tracker_.pose());
   const std::vector<Ellipsoid>& now = proxies_.ellipsoids();

@@ -99,6 +99,10 @@ class Context {
   void wakeAll();
   void wakeGarment(const GarmentSim* garment);
   bool garmentAsleep(const GarmentSim* garment) const { return adaptive_.asleep(garment); }
+  // The skeleton's calibration recuts garments over several steps (Recut, private): this many
+  // dressing frames a step. recutPending(): one is being dressed now.
+  static constexpr int kRecutFramesPerStep = 2;
+  bool recutPending() const { return !recuts_.empty(); }
 
  private:
   drape_context_desc desc_;
@@ -130,11 +134,29 @@ class Context {
   uint32_t fittedCalibration_ = 0;  // the tracker's calibrationCount() last seen
   SkeletonPose garmentRestPose(RestCut cut) const;
   void fitGarmentsToSkeleton();
-  // Refits the garments (every one, or those cut for `only` when given) to their cut's rest body
-  // (after a shape change or the tracker's calibration): all of them or, when one cannot be
-  // dressed on the new body, none (err says which and why). `refitted` counts them.
-  bool refitGarments(std::string& err, bool remake_templates, const RestCut* only = nullptr,
-                     size_t* refitted = nullptr);
+  // A recut in progress (the skeleton's calibration): each garment cut for the skeleton has its
+  // replacement, made on the new rest body, dressed kRecutFramesPerStep frames a step beside it
+  // (GarmentSim::Dressing) instead of all in the calibration's step; the step after the last one
+  // is dressed swaps them all in (each placed into that step's pose, as a new garment is). Why:
+  // dressing all at once held that one step up for the whole dressing (378 ms of 612 at 31 517
+  // particles; docs/garments.md, "Cut by kind"). The bones fitted before are kept to go back to
+  // should a replacement fail to dress (every garment then stays as it was, as refitGarments does).
+  struct Recut {
+    GarmentSim* garment = nullptr;
+    std::unique_ptr<GarmentSim> fresh;
+    GarmentSim::Dressing dressing;
+  };
+  std::vector<Recut> recuts_;
+  bool recutFitBefore_ = false;
+  std::array<float, kBoneCount> recutBonesBefore_{};
+  SkeletonPose recutTorsoBefore_{};
+  // Dresses the recuts' next frames, or swaps them in once all are dressed (beginStep).
+  void advanceRecuts();
+  void restoreFitBefore();
+  // Refits every garment to its cut's rest body at once, each carried there by ring skinning
+  // (after a shape change; the calibration's recut is spread over steps: Recut): all of them or,
+  // when one cannot be dressed on the new body, none (err says which and why).
+  bool refitGarments(std::string& err);
   std::vector<std::unique_ptr<GarmentSim>> garments_;
   std::vector<RestCut> garmentCuts_;  // garments_[i]'s cut
   std::vector<Ellipsoid> stepEllipsoids_;  // the ellipsoids at the end of the last step

@@ -31,6 +31,16 @@ constexpr float kMinStepS = 1e-5f;
 constexpr float kDressStartScale = 0.6f;
 // Soft choice of skinning segment (as the OBJ fit's default): see cloth/ring_skin.h.
 constexpr float kSkinBlendM = 0.015f;
+
+// out[k] = rest[k] with its radii scaled by s (out has rest's size).
+void scaleEllipsoids(const std::vector<Ellipsoid>& rest, float s, std::vector<Ellipsoid>& out) {
+  for (size_t k = 0; k < out.size() && k < rest.size(); ++k) {
+    out[k] = rest[k];
+    out[k].radii *= s;
+    out[k].refresh();
+  }
+}
+
 // A pelvis rotation beyond kPoseJumpRad + kMaxSpinRadPerS * dt in one step is no human motion.
 constexpr float kPoseJumpRad = 1.0f;          // 57 degrees
 constexpr float kMaxSpinRadPerS = 12.566f;    // two turns a second
@@ -142,7 +152,7 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
                                                const std::vector<Ellipsoid>& rest_ellipsoids,
                                                const std::vector<uint8_t>& ellipsoid_groups,
                                                std::string& err, bool cut_from_dressed,
-                                               TorsoReach torso_reach) {
+                                               TorsoReach torso_reach, Dressing* deferred) {
   if (std::string e = validate(params); !e.empty()) {
     err = e;
     return nullptr;
@@ -237,68 +247,92 @@ std::unique_ptr<GarmentSim> GarmentSim::create(const GarmentMesh& mesh, const To
   // the body grows from kDressStartScale of its size to full size over the first half of the
   // dressing time while the cloth is simulated, so collision pushes it out gradually and the
   // constraints keep it whole. Then it settles on the full-size body.
-  std::vector<Vec3> start(g->mesh_.positions);
-  if (!g->solver_->reset(start, err)) return nullptr;
-  const int frames = std::max(1, static_cast<int>(std::ceil(dress_time_s / kSettleFrameS - 1e-4f)));
-  const int grow = std::max(1, frames / 2);
-  std::vector<Ellipsoid> from(rest_ellipsoids), to(rest_ellipsoids);
-  auto scaled = [&](float s, std::vector<Ellipsoid>& out) {
-    for (size_t k = 0; k < out.size(); ++k) {
-      out[k] = rest_ellipsoids[k];
-      out[k].radii *= s;
-      out[k].refresh();
-    }
-  };
-  scaled(kDressStartScale, from);
+  Dressing local;
+  Dressing& d = deferred != nullptr ? *deferred : local;
+  d = Dressing{};
+  d.frames = std::max(1, static_cast<int>(std::ceil(dress_time_s / kSettleFrameS - 1e-4f)));
+  d.grow = std::max(1, d.frames / 2);
+  d.cut_from_dressed = cut_from_dressed;
+  d.solver = solver;
+  d.params = params;
+  d.topology = tp;
+  if (deferred != nullptr) d.body_copy = std::make_shared<const BodyModel>(body_rest);
+  d.body = deferred != nullptr ? d.body_copy.get() : &body_rest;
+  d.rest = rest_ellipsoids;
+  d.from = rest_ellipsoids;
+  d.to = rest_ellipsoids;
+  scaleEllipsoids(d.rest, kDressStartScale, d.from);
+  if (!g->solver_->reset(g->mesh_.positions, err)) return nullptr;
   GarmentSimParams weightless = params;
   weightless.xpbd.gravity = Vec3::Zero();
   if (cut_from_dressed && !g->solver_->setParams(weightless, err)) return nullptr;
-  for (int f = 0; f < frames; ++f) {
-    const float u = std::min(1.0f, static_cast<float>(f + 1) / static_cast<float>(grow));
-    scaled(kDressStartScale + (1.0f - kDressStartScale) * u, to);
-    g->runFrame(from, to, g->seen_pins_, kSettleFrameS);
-    from.swap(to);
-    if (cut_from_dressed && f + 1 == grow) {
+  if (deferred != nullptr) return g;
+  if (!g->dress(d, d.frames, err)) return nullptr;
+  return g;
+}
+
+bool GarmentSim::dress(Dressing& d, int frames, std::string& err) {
+  if (d.finished) return true;
+  if (d.body == nullptr) {
+    err = "no dressing to go on with";
+    return false;
+  }
+  const BodyModel& body_rest = *d.body;
+  const int end = std::min(d.frames, d.done_frames + std::max(frames, 0));
+  for (; d.done_frames < end; ++d.done_frames) {
+    const int f = d.done_frames;
+    const float u = std::min(1.0f, static_cast<float>(f + 1) / static_cast<float>(d.grow));
+    scaleEllipsoids(d.rest, kDressStartScale + (1.0f - kDressStartScale) * u, d.to);
+    runFrame(d.from, d.to, seen_pins_, kSettleFrameS);
+    d.from.swap(d.to);
+    if (d.cut_from_dressed && f + 1 == d.grow) {
       // Let the cut out to the shape the body gave it, then settle under gravity.
-      std::vector<Vec3> shape(g->particleCount());
-      for (size_t i = 0; i < shape.size(); ++i) shape[i] = g->solver_->x()[i].head<3>();
+      std::vector<Vec3> shape(particleCount());
+      for (size_t i = 0; i < shape.size(); ++i) shape[i] = solver_->x()[i].head<3>();
       const std::vector<float> flat_shape = flatten(shape);
       GarmentTopology cut;
-      if (!buildGarmentTopology(flat_shape.data(), shape.size(), g->mesh_.indices.data(), g->mesh_.indices.size(), tp,
-                                cut, err))
-        return nullptr;
-      g->topology_ = std::move(cut);
-      g->mesh_.positions = shape;
-      pinOffsetsFromPositions(body_rest, g->mesh_);
-      g->pinTargets(body_rest, g->seen_pins_);
-      g->solver_ = makeSolver(solver, g->topology_);
-      if (!g->setParams(params, err) || !g->solver_->reset(shape, err)) return nullptr;
+      if (!buildGarmentTopology(flat_shape.data(), shape.size(), mesh_.indices.data(), mesh_.indices.size(),
+                                d.topology, cut, err))
+        return false;
+      topology_ = std::move(cut);
+      mesh_.positions = shape;
+      pinOffsetsFromPositions(body_rest, mesh_);
+      pinTargets(body_rest, seen_pins_);
+      solver_ = makeSolver(d.solver, topology_);
+      if (!setParams(d.params, err) || !solver_->reset(shape, err)) return false;
     }
   }
+  if (d.done_frames < d.frames) return true;
   // Whatever is still inside (pinched) goes out now, without the escape limit.
+  std::vector<Vec3> start(particleCount());
   {
-    std::vector<Eigen::Vector4f> x(g->solver_->x(), g->solver_->x() + g->particleCount());
-    CollisionParams cp = params.xpbd.collision;
+    std::vector<Eigen::Vector4f> x(solver_->x(), solver_->x() + particleCount());
+    CollisionParams cp = d.params.xpbd.collision;
     cp.max_escape_m = 0.0f;
-    g->collider_.setEllipsoids(rest_ellipsoids.data(), rest_ellipsoids.data(),
-                               static_cast<int>(rest_ellipsoids.size()), params.collision_margin_m);
-    g->collider_.collide(x.data(), nullptr, x.size(), cp);
+    collider_.setEllipsoids(d.rest.data(), d.rest.data(), static_cast<int>(d.rest.size()),
+                            d.params.collision_margin_m);
+    collider_.collide(x.data(), nullptr, x.size(), cp);
     for (size_t i = 0; i < x.size(); ++i) start[i] = x[i].head<3>();
-    if (!g->solver_->reset(start, err)) return nullptr;
+    if (!solver_->reset(start, err)) return false;
   }
-  const std::vector<Vec3>& x = start;
-  g->dressed_.resize(x.size());
-  for (size_t i = 0; i < x.size(); ++i) g->dressed_[i] = g->solver_->x()[i].head<3>();
-  for (const Vec3& p : g->dressed_) {
+  dressed_.resize(start.size());
+  for (size_t i = 0; i < start.size(); ++i) dressed_[i] = solver_->x()[i].head<3>();
+  for (const Vec3& p : dressed_) {
     if (!isFinite(p)) {
       err = "the garment did not settle (non-finite positions while dressing): check its parameters";
-      return nullptr;
+      return false;
     }
   }
-  g->skin_.bind(body_rest, g->dressed_, kSkinBlendM);
-  g->openings_.bind(g->mesh_.indices, g->dressed_, body_rest);
-  g->last_ = GarmentStepStats{};
-  return g;
+  skin_.bind(body_rest, dressed_, kSkinBlendM);
+  openings_.bind(mesh_.indices, dressed_, body_rest);
+  last_ = GarmentStepStats{};
+  d.finished = true;
+  d.body = nullptr;
+  d.body_copy.reset();
+  d.rest.clear();
+  d.from.clear();
+  d.to.clear();
+  return true;
 }
 
 std::unique_ptr<GarmentSim> GarmentSim::createTemplate(const GarmentTemplateParams& tmpl, const TopologyParams& topo,
@@ -324,7 +358,8 @@ std::unique_ptr<GarmentSim> GarmentSim::createTemplate(const GarmentTemplatePara
 std::unique_ptr<GarmentSim> GarmentSim::refitted(const BodyModel& body_rest,
                                                  const std::vector<Ellipsoid>& rest_ellipsoids,
                                                  const std::vector<uint8_t>& ellipsoid_groups,
-                                                 std::string& err, bool remake_template) const {
+                                                 std::string& err, bool remake_template,
+                                                 Dressing* deferred) const {
   const Origin& o = *origin_;
   if (o.rest_rings.size() != body_rest.rings().size()) {
     err = "the new body has another ring layout than the one the garment was made on";
@@ -343,7 +378,7 @@ std::unique_ptr<GarmentSim> GarmentSim::refitted(const BodyModel& body_rest,
         mesh.positions.size() == o.mesh.positions.size()) {
       // The new cut keeps which cloth meets the legs (a template's torso cloth: createTemplate).
       std::unique_ptr<GarmentSim> g = create(mesh, o.topology, kind_, params_, o.dress_time_s, body_rest,
-                                             rest_ellipsoids, ellipsoid_groups, err, false, torso_reach_);
+                                             rest_ellipsoids, ellipsoid_groups, err, false, torso_reach_, deferred);
       if (g) g->origin_ = origin_;
       return g;
     }
@@ -356,7 +391,7 @@ std::unique_ptr<GarmentSim> GarmentSim::refitted(const BodyModel& body_rest,
   // shrank with the body, so the old offset in metres would put the pin inside or off the body).
   pinOffsetsFromPositions(body_rest, mesh);
   std::unique_ptr<GarmentSim> g = create(mesh, o.topology, kind_, params_, o.dress_time_s, body_rest,
-                                         rest_ellipsoids, ellipsoid_groups, err, true, torso_reach_);
+                                         rest_ellipsoids, ellipsoid_groups, err, true, torso_reach_, deferred);
   if (g) g->origin_ = origin_;
   return g;
 }

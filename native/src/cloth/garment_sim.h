@@ -129,13 +129,39 @@ class GarmentSim {
   // other templates that and the pelvis fill (proxies/proxy_builder.h), which trousers, their seat
   // and crotch cut round it, do not meet: meeting it stretched their seat (docs/proxies.md).
   enum class TorsoReach : uint8_t { Torso, Legs, LegsAndPelvis };
+  // A dressing in progress: what dress() needs to go on with a garment that create() made but, asked
+  // to defer it, did not dress. It keeps its own copies of the rest body and its ellipsoids, so the
+  // caller's may change meanwhile. Why: a garment cut again mid-session (the skeleton's
+  // calibration) is dressed a few frames per step beside the one it replaces, instead of in one
+  // step (Context, "recuts"; docs/garments.md, "Cut by kind").
+  struct Dressing {
+    int frames = 0;       // simulated 1/30 s frames of the whole dressing
+    int grow = 0;         // of which the body grows to full size
+    int done_frames = 0;  // run so far
+    bool finished = false;
+    bool cut_from_dressed = false;
+    ClothSolverKind solver = ClothSolverKind::Xpbd;
+    GarmentSimParams params;
+    TopologyParams topology;
+    std::shared_ptr<const BodyModel> body_copy;  // deferred: the rest body, copied
+    const BodyModel* body = nullptr;             // body_copy, or create()'s body_rest
+    std::vector<Ellipsoid> rest, from, to;       // the rest ellipsoids; the frame's, grown
+  };
+  // deferred: when given, the garment comes back made and placed on the rest pose but not dressed,
+  // and *deferred holds what dress() needs; else it is dressed before create() returns.
   static std::unique_ptr<GarmentSim> create(const GarmentMesh& mesh, const TopologyParams& topo,
                                             ClothSolverKind solver, const GarmentSimParams& params,
                                             float dress_time_s, const BodyModel& body_rest,
                                             const std::vector<Ellipsoid>& rest_ellipsoids,
                                             const std::vector<uint8_t>& ellipsoid_groups,
                                             std::string& err, bool cut_from_dressed = false,
-                                            TorsoReach torso_reach = TorsoReach::Torso);
+                                            TorsoReach torso_reach = TorsoReach::Torso,
+                                            Dressing* deferred = nullptr);
+  // Runs up to `frames` more frames of a deferred dressing, and when none are left finishes it
+  // (the dressed shape kept, the skin and openings bound): d.finished. Null-safe to call again once
+  // finished. False + err when the garment did not settle (non-finite positions); it is then
+  // unusable.
+  bool dress(Dressing& d, int frames, std::string& err);
   // A template garment: makeGarmentTemplate on body_rest, then create(). It remembers the template
   // and its layout, so refitted() cuts it again as that template on the new body.
   static std::unique_ptr<GarmentSim> createTemplate(const GarmentTemplateParams& tmpl, const TopologyParams& topo,
@@ -160,9 +186,10 @@ class GarmentSim {
   // (TemplateLayout) instead of being carried by skinning (the skeleton's calibration:
   // docs/garments.md, "Cut for the person's skeleton"; a shape change carries it, which measured
   // closer to a garment made for the new body there).
+  // deferred: as create()'s (the new garment comes back undressed).
   std::unique_ptr<GarmentSim> refitted(const BodyModel& body_rest, const std::vector<Ellipsoid>& rest_ellipsoids,
                                        const std::vector<uint8_t>& ellipsoid_groups, std::string& err,
-                                       bool remake_template = false) const;
+                                       bool remake_template = false, Dressing* deferred = nullptr) const;
   // Takes over `fresh` (from refitted()) and keeps what identifies this garment to its owner: the
   // C ABI token and owner, its step count and glitch counters; counts the refit.
   void replaceWith(GarmentSim&& fresh);
