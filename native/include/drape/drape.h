@@ -150,6 +150,9 @@ typedef enum drape_garment_fit {
    * geometry (spine, hip and shoulder joints) averaged over the calibration window, template
    * garments are made again on it with their first layout, OBJ garments carried to it
    * (drape_garment_stats.refits counts it; particles and triangles stay, the rest shape changes).
+   * The new cut is made in the calibration's step and dressed over the next steps (two 1/30 s
+   * frames a step beside the old cut, which the host goes on seeing), then swapped in: with the
+   * default dress time, 9 steps after the calibration's (drape_garment_desc.dress_time_s).
    * No refit when the person's rest pose is within 1 cm of the standard one. Less stretch on most
    * shared takes at 2 000 particles, more on some (skirts on the Kinect takes, coarse garments):
    * docs/garments.md. */
