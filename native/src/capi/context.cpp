@@ -170,10 +170,14 @@ void Context::fitGarmentsToSkeleton() {
   for (int j = 0; j < kJointCount; ++j)
     moved = std::max(moved, (fitted.position[static_cast<size_t>(j)] - current.position[static_cast<size_t>(j)]).norm());
   if (!(moved >= kRefitBelowM)) return;  // this person has the proportions the garments were cut for
-  recuts_.clear();  // an earlier calibration's recut still dressing: this one's replaces it
-  recutFitBefore_ = fitBones_;
-  recutBonesBefore_ = fittedBones_;
-  recutTorsoBefore_ = fittedTorso_;
+  // An earlier calibration's recut still dressing is replaced by this one's; the garments are still
+  // on the cut before it, so that is the one to go back to.
+  if (recuts_.empty()) {
+    recutFitBefore_ = fitBones_;
+    recutBonesBefore_ = fittedBones_;
+    recutTorsoBefore_ = fittedTorso_;
+  }
+  recuts_.clear();
   fitBones_ = true;
   fittedBones_ = tracker_.boneLengths();
   fittedTorso_ = torso;
