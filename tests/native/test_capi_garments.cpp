@@ -351,6 +351,14 @@ drape_garment* addTemplateCut(drape_context* ctx, int32_t kind, int32_t cut) {
 // two frames a step over 15 frames, then swaps them in (capi/context.h, Recut).
 constexpr int kPastTheRecut = 45;
 
+// A context that cuts its garments for the skeleton (drape_context_desc.garment_fit).
+ContextPtr makeSkeletonContext() {
+  drape_context_desc d;
+  EXPECT_EQ(drape_context_desc_init(&d), DRAPE_OK);
+  d.garment_fit = DRAPE_GARMENT_FIT_SKELETON;
+  return makeContext(&d);
+}
+
 uint32_t refitsOf(drape_garment* g) {
   drape_garment_stats s;
   s.struct_size = sizeof(s);
@@ -379,12 +387,8 @@ std::vector<drape_vec3> restOf(drape_garment* g) {
 // context's choice.
 TEST(CApiGarments, AGarmentsOwnCutOverridesTheContexts) {
   ContextPtr shapeCtx = makeContext();
-  drape_context_desc sd;
-  ASSERT_OK(drape_context_desc_init(&sd));
-  sd.garment_fit = DRAPE_GARMENT_FIT_SKELETON;
-  drape_context* raw = nullptr;
-  ASSERT_OK(drape_context_create(&sd, &raw));
-  ContextPtr skeletonCtx(raw);
+  ContextPtr skeletonCtx = makeSkeletonContext();
+  ASSERT_NE(skeletonCtx, nullptr);
   drape_garment* top = addTemplateCut(shapeCtx.get(), DRAPE_GARMENT_TSHIRT, DRAPE_GARMENT_CUT_CONTEXT);
   drape_garment* legs = addTemplateCut(shapeCtx.get(), DRAPE_GARMENT_TROUSERS, DRAPE_GARMENT_CUT_SKELETON);
   drape_garment* kept = addTemplateCut(skeletonCtx.get(), DRAPE_GARMENT_TSHIRT, DRAPE_GARMENT_CUT_SHAPE);
@@ -455,12 +459,8 @@ TEST(CApiGarments, ByKindCutsTrousersAndLongSleevesForTheSkeleton) {
   }
   EXPECT_EQ(refitsOf(patch), 0u);
   // In a context that cuts for the skeleton, BY_KIND cuts every garment for it.
-  drape_context_desc sd;
-  ASSERT_OK(drape_context_desc_init(&sd));
-  sd.garment_fit = DRAPE_GARMENT_FIT_SKELETON;
-  drape_context* raw = nullptr;
-  ASSERT_OK(drape_context_create(&sd, &raw));
-  ContextPtr skeletonCtx(raw);
+  ContextPtr skeletonCtx = makeSkeletonContext();
+  ASSERT_NE(skeletonCtx, nullptr);
   drape_garment* top = addTemplateCut(skeletonCtx.get(), DRAPE_GARMENT_TSHIRT, DRAPE_GARMENT_CUT_BY_KIND);
   ASSERT_NE(top, nullptr);
   EXPECT_EQ(cutOf(top), DRAPE_GARMENT_FIT_SKELETON);
