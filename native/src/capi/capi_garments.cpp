@@ -348,9 +348,7 @@ DRAPE_API drape_result DRAPE_CALL drape_context_add_garment_template(drape_conte
     tp.ease_m = t.ease_m;
     tp.length_scale = t.length_scale;
     std::string err;
-    // Trousers and long sleeves reach the ankles and wrists (drape_garment_cut BY_KIND).
-    const bool limbs_must_fit = tp.kind == drape::GarmentKind::Trousers || tp.kind == drape::GarmentKind::LongSleeve;
-    const Context::RestCut cut = ctx->cutFor(d.cut, limbs_must_fit);
+    const Context::RestCut cut = ctx->cutFor(d.cut, drape::garmentReachesLimbEnds(tp.kind));
     auto g = GarmentSim::createTemplate(tp, topologyFrom(d), static_cast<drape::ClothSolverKind>(d.solver), sim,
                                         d.dress_time_s, ctx->restBody(cut), ctx->restEllipsoids(cut),
                                         ctx->restEllipsoidGroups(cut), err);

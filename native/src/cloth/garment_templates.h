@@ -57,6 +57,11 @@ bool makeGarmentTemplate(const BodyModel& body_in_rest_pose, const GarmentTempla
                          const TemplateLayout* replay = nullptr);
 
 const char* garmentKindName(GarmentKind kind);
+// Trousers and the long-sleeve top: their legs or sleeves reach the ankles or wrists, so they stay
+// round the person's limbs only when cut to the person's limb lengths (DRAPE_GARMENT_CUT_BY_KIND).
+inline bool garmentReachesLimbEnds(GarmentKind kind) {
+  return kind == GarmentKind::Trousers || kind == GarmentKind::LongSleeve;
+}
 
 // pin_local from where the pinned particles are: each one's offset in its ring's frame on `body`
 // (positions and pin_ring set; pin_local is resized).
