@@ -133,7 +133,7 @@ class GarmentSim {
   // to defer it, did not dress. It keeps its own copies of the rest body and its ellipsoids, so the
   // caller's may change meanwhile. Why: a garment cut again mid-session (the skeleton's
   // calibration) is dressed a few frames per step beside the one it replaces, instead of in one
-  // step (Context, "recuts"; docs/garments.md, "Cut by kind").
+  // step (Context::Recut in capi/context.h; docs/garments.md, "Cut by kind").
   struct Dressing {
     int frames = 0;       // simulated 1/30 s frames of the whole dressing
     int grow = 0;         // of which the body grows to full size
@@ -158,9 +158,9 @@ class GarmentSim {
                                             TorsoReach torso_reach = TorsoReach::Torso,
                                             Dressing* deferred = nullptr);
   // Runs up to `frames` more frames of a deferred dressing, and when none are left finishes it
-  // (the dressed shape kept, the skin and openings bound): d.finished. Null-safe to call again once
-  // finished. False + err when the garment did not settle (non-finite positions); it is then
-  // unusable.
+  // (the dressed shape kept, the skin and openings bound): d.finished. Once finished, a call does
+  // nothing and returns true. False + err when the garment did not settle (non-finite positions);
+  // it is then unusable.
   bool dress(Dressing& d, int frames, std::string& err);
   // A template garment: makeGarmentTemplate on body_rest, then create(). It remembers the template
   // and its layout, so refitted() cuts it again as that template on the new body.
