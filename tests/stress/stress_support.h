@@ -118,8 +118,24 @@ std::vector<T> variants(const T (&all)[N], std::initializer_list<size_t> under_s
   return kept;
 }
 
+// The scenarios dress a T-shirt; DRAPE_STRESS_GARMENT=tshirt|longsleeve|skirt|dress|trousers
+// dresses another template (with the default desc: trousers and the long-sleeve cut by kind, for
+// the person's skeleton once calibrated), to see whether a scenario's outcome depends on the
+// garment (docs/robustness.md, "Sensitivity"). The bounds were set on the T-shirt.
+inline int32_t defaultGarmentKind() {
+  const char* w = std::getenv("DRAPE_STRESS_GARMENT");
+  if (w == nullptr) return DRAPE_GARMENT_TSHIRT;
+  const std::string k = w;
+  if (k == "longsleeve") return DRAPE_GARMENT_LONG_SLEEVE;
+  if (k == "skirt") return DRAPE_GARMENT_SKIRT;
+  if (k == "dress") return DRAPE_GARMENT_DRESS;
+  if (k == "trousers") return DRAPE_GARMENT_TROUSERS;
+  if (k != "tshirt") ADD_FAILURE() << "DRAPE_STRESS_GARMENT=" << k << " is not tshirt, longsleeve, skirt, dress or trousers";
+  return DRAPE_GARMENT_TSHIRT;
+}
+
 struct Dressing {
-  int32_t kind = DRAPE_GARMENT_TSHIRT;
+  int32_t kind = defaultGarmentKind();
   uint32_t particles = defaultParticles();
   bool set_shape = false;
   drape_body_shape shape{};
