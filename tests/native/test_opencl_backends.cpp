@@ -205,6 +205,37 @@ TEST(OpenClBackend, AGarmentRefittedToANewBodyShapeStaysOnTheDevice) {
   for (size_t i = 0; i < g->particleCount(); ++i) ASSERT_TRUE(g->positions()[i].allFinite());
 }
 
+// The skeleton's calibration recuts a device garment over several steps (capi/context.h, Recut):
+// the old cut goes on stepping on the device meanwhile, the new one (dressed on the CPU) goes to
+// the device when it is swapped in.
+TEST(OpenClBackend, AGarmentRecutAtTheCalibrationStaysOnTheDevice) {
+  DRAPE_REQUIRE_OPENCL(rt);
+  drape_context_desc d = test::defaultDesc();
+  d.garment_fit = DRAPE_GARMENT_FIT_SKELETON;
+  Context ctx(d);
+  std::string err;
+  GarmentSim* g = test::addTemplate(ctx, GarmentKind::Trousers, 300, ClothSolverKind::Xpbd, GarmentSimParams{}, err);
+  ASSERT_NE(g, nullptr) << err;
+  ASSERT_TRUE(chooseBackend(ctx, DRAPE_BACKEND_OPENCL, err)) << err;
+  ASSERT_EQ(g->backend(), GarmentBackend::OpenCl);
+  // A person 10 % smaller than the shape's standard proportions: the calibration recuts.
+  SkeletonPose person = restPose(ctx.shape());
+  const Vec3 pivot = person.position[static_cast<size_t>(Joint::Pelvis)];
+  for (Vec3& j : person.position) j = pivot + 0.9f * (j - pivot);
+  int f = 0;
+  for (; f < 30; ++f) stepPose(ctx, person, f / 30.0, 1.0f / 30.0f);
+  ASSERT_TRUE(ctx.recutPending());
+  EXPECT_EQ(g->backend(), GarmentBackend::OpenCl) << "the old cut steps on, on the device";
+  for (; f < 45 && ctx.recutPending(); ++f) stepPose(ctx, person, f / 30.0, 1.0f / 30.0f);
+  EXPECT_FALSE(ctx.recutPending());
+  EXPECT_EQ(g->refits(), 1u);
+  EXPECT_EQ(g->backend(), GarmentBackend::OpenCl) << "the new cut moved to the device it was on";
+  for (int k = 0; k < 5; ++k, ++f) stepPose(ctx, person, f / 30.0, 1.0f / 30.0f);
+  EXPECT_FALSE(g->deviceFailed(nullptr));
+  EXPECT_GT(g->lastStep().substeps, 0);
+  for (size_t i = 0; i < g->particleCount(); ++i) ASSERT_TRUE(g->positions()[i].allFinite());
+}
+
 TEST(OpenClBackend, AutoKeepsSmallGarmentsOnTheCpu) {
   DRAPE_REQUIRE_OPENCL(rt);
   Context ctx(test::defaultDesc());
