@@ -532,6 +532,53 @@ TEST(SkeletonTracker, FlippedSkeletonIsAPoseJumpAndAPirouetteIsNot) {
   EXPECT_EQ(spin.poseJumpCount(), 0u);
 }
 
+// A tracked limb bone reversed from one frame to the next (thighs pointing up: knees reflected
+// through the hips) is a pose jump too, going and coming back; a fast real swing is not, nor are
+// the same reversals of joints the sensor only infers.
+TEST(SkeletonTracker, AFlippedTrackedLimbIsAPoseJumpAndASwingIsNot) {
+  auto reversedThighs = [](SkeletonPose p) {
+    for (auto [hip, knee] : {std::pair{Joint::HipL, Joint::KneeL}, std::pair{Joint::HipR, Joint::KneeR}}) {
+      const Vec3 h = p.position[static_cast<size_t>(idx(hip))];
+      p.position[static_cast<size_t>(idx(knee))] = 2.0f * h - p.position[static_cast<size_t>(idx(knee))];
+    }
+    return p;
+  };
+  SkeletonTracker tr;
+  double t = pushStill(tr, standing(), 0.0, 40);
+  tr.push(reversedThighs(standing()), t);
+  t += kDt;
+  EXPECT_TRUE(tr.poseJumpedLastPush());
+  t = pushStill(tr, reversedThighs(standing()), t, 20);
+  EXPECT_FALSE(tr.poseJumpedLastPush());
+  tr.push(standing(), t);
+  t += kDt;
+  EXPECT_TRUE(tr.poseJumpedLastPush());
+  EXPECT_EQ(tr.poseJumpCount(), 2u);
+
+  // The same with the knees inferred: a guess, not a jump.
+  SkeletonTracker guessed;
+  SkeletonPose inferred = reversedThighs(standing());
+  for (Joint k : {Joint::KneeL, Joint::KneeR}) inferred.state[static_cast<size_t>(idx(k))] = TrackingState::Inferred;
+  t = pushStill(guessed, standing(), 0.0, 40);
+  guessed.push(inferred, t);
+  EXPECT_EQ(guessed.poseJumpCount(), 0u);
+
+  // A right forearm swinging round the elbow at 25 rad/s (a fast throw: 48 degrees a frame at
+  // 30 Hz) is no jump.
+  SkeletonTracker swing;
+  double ts = 0.0;
+  const int elbow = idx(Joint::ElbowR);
+  for (int i = 0; i < 60; ++i, ts += kDt) {
+    SkeletonPose p = standing();
+    const Mat3 R = Eigen::AngleAxisf(25.0f * static_cast<float>(ts), Vec3::UnitZ()).toRotationMatrix();
+    for (Joint j : {Joint::WristR, Joint::HandR})
+      p.position[static_cast<size_t>(idx(j))] = p.position[elbow] + R * (p.position[static_cast<size_t>(idx(j))] - p.position[elbow]);
+    swing.push(p, ts);
+    EXPECT_FALSE(swing.poseJumpedLastPush()) << "frame " << i;
+  }
+  EXPECT_EQ(swing.poseJumpCount(), 0u);
+}
+
 TEST(SkeletonTracker, TeleportForOneFrameFlaggedCountedAndFollowed) {
   SkeletonTracker tr;
   double t = pushStill(tr, standing(), 0.0, 40);

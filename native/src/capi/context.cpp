@@ -351,6 +351,7 @@ drape_result Context::update(std::string& err) {
     teleported_ = tracker_.teleportedLastPush();
     poseJumped_ = tracker_.poseJumpedLastPush();
     teleportPending_ = teleportPending_ || teleported_;
+    poseJumpPending_ = poseJumpPending_ || poseJumped_;
     ++updates_;
   } else if (!shapeDirty_) {
     return DRAPE_OK;  // nothing new
@@ -557,6 +558,7 @@ drape_result Context::beginStep(float dt, std::string& err) {
     const std::vector<Ellipsoid>* woke = adaptive_.wakeStart(g.get(), now);
     g->setTrackingNoise(tracker_.noiseSigmaM());  // noise bursts: garment_recovery.cpp
     g->setLegsTrusted(left_leg, right_leg);
+    g->setPoseJumped(poseJumpPending_);
     // Device frames are only staged here: the caller runs them all together (runStagedFrames).
     g->stepBegin(*body_, woke ? *woke : stepEllipsoids_, now, dt, teleportPending_, true);
     stepping_.push_back(g.get());
@@ -584,6 +586,7 @@ void Context::endStep() {
     if (slept > 0) ++skips_.stages_skipped;
   }
   teleportPending_ = false;
+  poseJumpPending_ = false;
   stepEllipsoids_ = now;
   freshAtStep_ = fresh_;
   stepMs_ = msSince(stepT0_);

@@ -180,6 +180,7 @@ class Context {
   };
   PosePath placement_[2];
   bool teleportPending_ = false;           // a teleport since the last step
+  bool poseJumpPending_ = false;           // a pose jump (tracker.h) since the last step
   double stepMs_ = 0.0;
 
   SkeletonPose queued_{};

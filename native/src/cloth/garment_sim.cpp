@@ -691,7 +691,7 @@ void GarmentSim::stepBegin(const BodyModel& body, const std::vector<Ellipsoid>& 
     recheck_legs_ = 0;
   }
   const bool burst_ended = tracked_ && noiseBurstEnded();
-  if (!tracked_ || poseJumped(pr, dt)) {
+  if (!tracked_ || host_pose_jump_ || poseJumped(pr, dt)) {
     // First frame, or a pose no body reaches in dt from the last one (a skeleton flipped upside
     // down for a frame): the garment is put where the body's rings carry its dressed shape.
     last_.teleport_reset = tracked_;

@@ -261,6 +261,13 @@ class GarmentSim {
   // Whether each leg's ellipsoids are trusted this frame (Context: hip and knee Tracked); while
   // one is not, torso cloth passes through it as before. Cheap when nothing changed.
   void setLegsTrusted(bool left, bool right);
+  // The tracker saw a pose jump since the last step (SkeletonTracker::poseJumpedLastPush: the
+  // torso, or a tracked limb bone, turned farther than a person can): the next step treats it as
+  // one as it does a pelvis turning too fast (poseJumped()): the state before it kept, the garment
+  // placed on the new pose, and put back when a jump returns to a pose its pins match. Why: a
+  // thigh reported pointing up for a second dragged trouser legs through the torso, and they did
+  // not come back (docs/robustness.md, "The same scenarios on the other garments").
+  void setPoseJumped(bool jumped) { host_pose_jump_ = jumped; }
   // The body chain whose surface p is nearest (rings: as maskFor's). u, when given: where along
   // that chain, in its joints' units (an arm: 0 at the shoulder joint, 1 at the elbow).
   static int nearestChain(const BodyModel& body, const std::vector<RingPose>& rings, const Vec3& p,
@@ -400,6 +407,7 @@ class GarmentSim {
   // frame, pose jump) or when the leg was last trusted again, or none since (leg_clear_, one entry
   // per ellipsoid; empty: all clear). Pushed out at once, cloth a leg had passed into tore.
   TorsoReach torso_reach_ = TorsoReach::Torso;  // create's: not Torso = torso cloth has kTorsoOverLeg bits
+  bool host_pose_jump_ = false;  // setPoseJumped
   bool host_legs_[2] = {true, true};
   uint8_t recheck_legs_ = 0;  // bit per side: trusted again since the last step
   std::vector<uint8_t> leg_clear_;

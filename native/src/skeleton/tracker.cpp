@@ -97,6 +97,7 @@ void SkeletonTracker::reset() {
   noise_dt1_ = 0.0f;
   noise_var_ = 0.0f;
   have_torso_ = false;
+  limb_dir_.fill(Vec3::Zero());
   pose_jumped_ = false;
   pose_jumps_ = 0;
   teleported_ = false;
@@ -357,6 +358,34 @@ void SkeletonTracker::push(const SkeletonPose& raw, double time_s) {
         ++pose_jumps_;
         restart = true;
       }
+    }
+    // Limb bones: their directions in the torso's frame (which takes the body's own turning out).
+    // Not on a noisy sensor (the estimate of the frames so far above kNoiseReferenceM): 5 cm of
+    // jitter at both ends of a 25 cm forearm turns it that far now and then.
+    const float limb_gap =
+        have_torso_ ? static_cast<float>(std::clamp(t - last_torso_t_, 0.0, static_cast<double>(kMaxFilterGapS))) : 0.0f;
+    const bool quiet = noise_var_ < kNoiseReferenceM * kNoiseReferenceM;
+    bool limb_jumped = false;
+    for (const Joint child : {Joint::ElbowL, Joint::WristL, Joint::ElbowR, Joint::WristR, Joint::KneeL, Joint::AnkleL,
+                              Joint::KneeR, Joint::AnkleR}) {
+      const int b = idx(child) - 1;  // the bone ending at `child`
+      const int pa = boneParent(b);
+      const Vec3 d = torso.transpose() * (raw.position[idx(child)] - raw.position[pa]);
+      Vec3& last = limb_dir_[static_cast<size_t>(b)];
+      if (st[pa] != TrackingState::Tracked || st[idx(child)] != TrackingState::Tracked || !(d.norm() > 1e-3f)) {
+        last = Vec3::Zero();  // not compared across an untracked frame
+        continue;
+      }
+      const Vec3 u = d.normalized();
+      if (quiet && have_torso_ && last.squaredNorm() > 0.5f &&
+          std::acos(std::clamp(u.dot(last), -1.0f, 1.0f)) > kPoseJumpRad + kMaxTurnRadPerS * limb_gap)
+        limb_jumped = true;
+      last = u;
+    }
+    if (limb_jumped && !pose_jumped_) {
+      pose_jumped_ = true;
+      ++pose_jumps_;
+      restart = true;
     }
     have_torso_ = true;
     last_torso_ = torso;

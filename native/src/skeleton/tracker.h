@@ -49,6 +49,12 @@ constexpr float kNoiseTimeConstantS = 0.5f;
 // A raw torso (pelvis, spine-shoulder, hips, shoulders) turning beyond kPoseJumpRad +
 // kMaxTurnRadPerS * dt between two pushes is a pose jump: no person turns that fast (a pirouette
 // is ~2 turns a second); 90 degrees on top keeps 5 cm of sensor noise from looking like one.
+// The same for a limb bone (upper arm, forearm, thigh, shin) whose two joints the sensor tracks:
+// its direction in the raw torso frame turning beyond that between two pushes (a thigh reported
+// pointing up, knees above the hips, from one frame to the next). Inferred joints are left out:
+// the close-range take's guessed legs turn 81-137 degrees from one frame to the next six times
+// (docs/skeleton.md, "Pose jumps"); tracked ones on the shared takes never beyond 57. So is a
+// noisy sensor (noise estimate above kNoiseReferenceM: heavy jitter turns a forearm that far).
 constexpr float kPoseJumpRad = 1.5708f;
 constexpr float kMaxTurnRadPerS = 12.566f;
 constexpr float kNoiseReferenceM = 0.015f;
@@ -68,7 +74,8 @@ class SkeletonTracker {
   uint32_t calibrationCount() const { return calibrations_; }
   const std::array<float, kBoneCount>& boneLengths() const;  // current (calibrating: running estimate) lengths
   bool teleportedLastPush() const;
-  // The last push's raw torso turned farther than a person can in its dt (filters restarted).
+  // The last push's raw torso, or a tracked limb bone in the torso's frame, turned farther than a
+  // person can in its dt (filters restarted).
   bool poseJumpedLastPush() const;
   uint32_t poseJumpCount() const;
   // Estimated sensor noise (standard deviation per coordinate, metres) and the One-Euro beta in
@@ -135,6 +142,7 @@ class SkeletonTracker {
   bool have_torso_ = false;
   Mat3 last_torso_ = Mat3::Identity();
   double last_torso_t_ = 0.0;
+  std::array<Vec3, kBoneCount> limb_dir_{};  // the last push's tracked limb bones, torso frame (0: none)
   bool pose_jumped_ = false;
   uint32_t pose_jumps_ = 0;
 };
