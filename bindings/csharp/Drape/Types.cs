@@ -410,8 +410,9 @@ namespace Drape
         public byte Teleported;
         /// <summary>calibrated (uint8_t): 1 once bone lengths are frozen.</summary>
         public byte Calibrated;
-        /// <summary>pose_jumped (uint8_t): 1 if the last update's frame was a pose jump (the torso
-        /// turned farther than a person can in the frame time; filters restarted, garments re-placed).</summary>
+        /// <summary>pose_jumped (uint8_t): 1 if the last update's frame was a pose jump (the torso, or a limb
+        /// bone with both joints tracked, turned farther than a person can in the frame time; filters restarted,
+        /// garments re-placed and put back when the pose returns).</summary>
         public byte PoseJumped;
         /// <summary>reserved1.</summary>
         public byte Reserved1;

@@ -390,9 +390,11 @@ typedef struct drape_frame_stats {
   uint32_t teleports;         /* teleports detected so far */
   uint8_t teleported;         /* 1 if the last update's frame was a teleport */
   uint8_t calibrated;         /* 1 once bone lengths are frozen */
-  uint8_t pose_jumped;        /* 1 if the last update's frame was a pose jump: the torso turned
-                                 farther than a person can in the frame time (a skeleton flipped
-                                 upside down); filters restarted, garments re-placed */
+  uint8_t pose_jumped;        /* 1 if the last update's frame was a pose jump: the torso, or a
+                                 limb bone with both joints tracked, turned farther than a person
+                                 can in the frame time (a skeleton flipped upside down, thighs
+                                 reported pointing up); filters restarted, garments re-placed and
+                                 put back when the pose returns */
   uint8_t reserved1;
   double last_timestamp_s;    /* of the last accepted frame */
   double skeleton_ms;         /* wall time of the last update's skeleton stage */
