@@ -259,6 +259,17 @@ std::string statsJson(const ReplayStats& s) {
   return w.str();
 }
 
+namespace {
+// The summary's `fit` line: what the garment is cut for, and why.
+std::string fitText(const ReplayStats& s) {
+  const bool skeleton = s.garment_fit == DRAPE_GARMENT_FIT_SKELETON;
+  std::string text = skeleton ? "the person's skeleton once calibrated" : "the body shape's standard proportions";
+  if (s.garment_fit_by_kind) text += skeleton ? " (by its kind: limbs to the wrists or ankles)" : " (by its kind)";
+  else if (skeleton) text += " (--garment-fit skeleton)";
+  return text;
+}
+}  // namespace
+
 std::string summaryText(const ReplayStats& s, const std::string& obj_dir, const std::string& stats_path) {
   std::string o;
   appendf(o, "drape-replay (Drape %s)\n", s.drape_version.c_str());
@@ -284,11 +295,7 @@ std::string summaryText(const ReplayStats& s, const std::string& obj_dir, const 
         s.solver == DRAPE_SOLVER_MASS_SPRING ? "massspring" : "xpbd", s.substep_hz, passes.c_str(), s.particles,
         s.attached, s.garment_triangles);
     appendf(o, "fit         %s%s\n",
-            s.garment_fit != DRAPE_GARMENT_FIT_SKELETON
-                ? (s.garment_fit_by_kind ? "the body shape's standard proportions (by its kind)"
-                                         : "the body shape's standard proportions")
-                : (s.garment_fit_by_kind ? "the person's skeleton once calibrated (by its kind: limbs to the wrists or ankles)"
-                                         : "the person's skeleton once calibrated (--garment-fit skeleton)"),
+            fitText(s).c_str(),
             s.garment_fit != DRAPE_GARMENT_FIT_SKELETON ? ""
             : s.refits > 0 ? (", cut again " + std::to_string(s.refits) + "x").c_str()
                            : ", no refit (proportions within 1 cm of the standard ones, or not calibrated)");

@@ -152,7 +152,7 @@ drape_result Context::setShape(const BodyShapeInput& in, std::string& err) {
 }
 
 SkeletonPose Context::garmentRestPose(RestCut cut) const {
-  return cut == kCutSkeleton && fitBones_ ? restPoseWithBones(shape_, kGarmentRestArmDownDeg, fittedBones_, &fittedTorso_)
+  return cut == kCutSkeleton && fit_.on ? restPoseWithBones(shape_, kGarmentRestArmDownDeg, fit_.bones, &fit_.torso)
                                           : restPose(shape_, kGarmentRestArmDownDeg);
 }
 
@@ -172,15 +172,9 @@ void Context::fitGarmentsToSkeleton() {
   if (!(moved >= kRefitBelowM)) return;  // this person has the proportions the garments were cut for
   // An earlier calibration's recut still dressing is replaced by this one's; the garments are still
   // on the cut before it, so that is the one to go back to.
-  if (recuts_.empty()) {
-    recutFitBefore_ = fitBones_;
-    recutBonesBefore_ = fittedBones_;
-    recutTorsoBefore_ = fittedTorso_;
-  }
+  if (recuts_.empty()) fitBeforeRecut_ = fit_;
   recuts_.clear();
-  fitBones_ = true;
-  fittedBones_ = tracker_.boneLengths();
-  fittedTorso_ = torso;
+  fit_ = BoneFit{true, tracker_.boneLengths(), torso};
   rest_[kCutSkeleton].body.reset();
   // The replacements, made now and dressed over the next steps (advanceRecuts): all of them or,
   // when one cannot be made on the new body, none.
@@ -203,9 +197,7 @@ void Context::fitGarmentsToSkeleton() {
 }
 
 void Context::restoreFitBefore() {
-  fitBones_ = recutFitBefore_;
-  fittedBones_ = recutBonesBefore_;
-  fittedTorso_ = recutTorsoBefore_;
+  fit_ = fitBeforeRecut_;
   rest_[kCutSkeleton].body.reset();
   if (contextCut() == kCutSkeleton) proxyBounds_.clear();
 }
@@ -226,16 +218,10 @@ void Context::advanceRecuts() {
     }
     return;
   }
-  ReachParams rp;
-  rp.margin_m = options_.reach_margin_m;
   for (Recut& r : recuts_) {
-    GarmentSim& g = *r.garment;
     std::string unused;
-    r.fresh->setParams(g.params(), unused);  // the host's parameters of now (validated when set)
-    g.replaceWith(std::move(*r.fresh));
-    adaptive_.removeGarment(&g);
-    adaptive_.addGarment(&g, garmentReach(g, rp));
-    applyBackend(g);
+    r.fresh->setParams(r.garment->params(), unused);  // the host's parameters of now (validated when set)
+    swapIn(*r.garment, std::move(*r.fresh));
   }
   recuts_.clear();
   reachDirty_ = true;
@@ -253,16 +239,17 @@ bool Context::refitGarments(std::string& err) {
       return false;
     }
   }
+  for (size_t i = 0; i < garments_.size(); ++i) swapIn(*garments_[i], std::move(*refits[i]));
+  return true;
+}
+
+void Context::swapIn(GarmentSim& garment, GarmentSim&& fresh) {
+  garment.replaceWith(std::move(fresh));
   ReachParams rp;
   rp.margin_m = options_.reach_margin_m;
-  for (size_t i = 0; i < garments_.size(); ++i) {
-    GarmentSim& g = *garments_[i];
-    g.replaceWith(std::move(*refits[i]));
-    adaptive_.removeGarment(&g);
-    adaptive_.addGarment(&g, garmentReach(g, rp));
-    applyBackend(g);
-  }
-  return true;
+  adaptive_.removeGarment(&garment);
+  adaptive_.addGarment(&garment, garmentReach(garment, rp));
+  applyBackend(garment);
 }
 
 drape_result Context::pushFrame(const drape_skeleton_frame& f, std::string& err) {

@@ -124,12 +124,15 @@ class Context {
   RestSlot rest_[2];
   RestSlot& restSlot(RestCut cut);
   // Garments cut for the skeleton are cut on the rest pose with the person's bones once the
-  // tracker has calibrated them (before that, the shape's standard proportions). fitBones_ says
+  // tracker has calibrated them (before that, the shape's standard proportions). fit_ says
   // which pose the skeleton cut's rest body takes (garmentRestPose): from the bone lengths and
   // averaged torso of the calibration fitted last.
-  bool fitBones_ = false;
-  std::array<float, kBoneCount> fittedBones_{};
-  SkeletonPose fittedTorso_{};
+  struct BoneFit {
+    bool on = false;  // false: the shape's standard proportions
+    std::array<float, kBoneCount> bones{};
+    SkeletonPose torso{};
+  };
+  BoneFit fit_;
   TorsoAverage torsoAverage_;  // the torso over the calibration window
   uint32_t fittedCalibration_ = 0;  // the tracker's calibrationCount() last seen
   SkeletonPose garmentRestPose(RestCut cut) const;
@@ -147,9 +150,7 @@ class Context {
     GarmentSim::Dressing dressing;
   };
   std::vector<Recut> recuts_;
-  bool recutFitBefore_ = false;
-  std::array<float, kBoneCount> recutBonesBefore_{};
-  SkeletonPose recutTorsoBefore_{};
+  BoneFit fitBeforeRecut_;
   // Dresses the recuts' next frames, or swaps them in once all are dressed (beginStep).
   void advanceRecuts();
   void restoreFitBefore();
@@ -157,6 +158,8 @@ class Context {
   // (after a shape change; the calibration's recut is spread over steps: Recut): all of them or,
   // when one cannot be dressed on the new body, none (err says which and why).
   bool refitGarments(std::string& err);
+  // A garment takes over its new cut (GarmentSim::replaceWith), with its reach and backend.
+  void swapIn(GarmentSim& garment, GarmentSim&& fresh);
   std::vector<std::unique_ptr<GarmentSim>> garments_;
   std::vector<RestCut> garmentCuts_;  // garments_[i]'s cut
   std::vector<Ellipsoid> stepEllipsoids_;  // the ellipsoids at the end of the last step

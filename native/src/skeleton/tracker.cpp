@@ -349,10 +349,11 @@ void SkeletonTracker::push(const SkeletonPose& raw, double time_s) {
   pose_jumped_ = false;
   Mat3 torso;
   if (rawTorsoFrame(raw, st, torso)) {
+    const float gap =
+        have_torso_ ? static_cast<float>(std::clamp(t - last_torso_t_, 0.0, static_cast<double>(kMaxFilterGapS))) : 0.0f;
     if (have_torso_) {
       const Mat3 R = torso * last_torso_.transpose();
       const float c = std::clamp(0.5f * (R.trace() - 1.0f), -1.0f, 1.0f);
-      const float gap = static_cast<float>(std::clamp(t - last_torso_t_, 0.0, static_cast<double>(kMaxFilterGapS)));
       if (std::acos(c) > kPoseJumpRad + kMaxTurnRadPerS * gap) {
         pose_jumped_ = true;
         ++pose_jumps_;
@@ -362,8 +363,6 @@ void SkeletonTracker::push(const SkeletonPose& raw, double time_s) {
     // Limb bones: their directions in the torso's frame (which takes the body's own turning out).
     // Not on a noisy sensor (the estimate of the frames so far above kNoiseReferenceM): 5 cm of
     // jitter at both ends of a 25 cm forearm turns it that far now and then.
-    const float limb_gap =
-        have_torso_ ? static_cast<float>(std::clamp(t - last_torso_t_, 0.0, static_cast<double>(kMaxFilterGapS))) : 0.0f;
     const bool quiet = noise_var_ < kNoiseReferenceM * kNoiseReferenceM;
     bool limb_jumped = false;
     for (const Joint child : {Joint::ElbowL, Joint::WristL, Joint::ElbowR, Joint::WristR, Joint::KneeL, Joint::AnkleL,
@@ -378,7 +377,7 @@ void SkeletonTracker::push(const SkeletonPose& raw, double time_s) {
       }
       const Vec3 u = d.normalized();
       if (quiet && have_torso_ && last.squaredNorm() > 0.5f &&
-          std::acos(std::clamp(u.dot(last), -1.0f, 1.0f)) > kPoseJumpRad + kMaxTurnRadPerS * limb_gap)
+          std::acos(std::clamp(u.dot(last), -1.0f, 1.0f)) > kPoseJumpRad + kMaxTurnRadPerS * gap)
         limb_jumped = true;
       last = u;
     }
