@@ -373,6 +373,15 @@ uint8_t cutOf(drape_garment* g) {
   return s.cut;
 }
 
+float extentY(const std::vector<drape_vec3>& v) {
+  float lo = 1e30f, hi = -1e30f;
+  for (const drape_vec3& p : v) {
+    lo = std::min(lo, p.y);
+    hi = std::max(hi, p.y);
+  }
+  return hi - lo;
+}
+
 std::vector<drape_vec3> restOf(drape_garment* g) {
   uint32_t vertices = 0, indices = 0;
   EXPECT_EQ(drape_garment_get_mesh_size(g, &vertices, &indices), DRAPE_OK) << lastError();
@@ -464,6 +473,79 @@ TEST(CApiGarments, ByKindCutsTrousersAndLongSleevesForTheSkeleton) {
   drape_garment* top = addTemplateCut(skeletonCtx.get(), DRAPE_GARMENT_TSHIRT, DRAPE_GARMENT_CUT_BY_KIND);
   ASSERT_NE(top, nullptr);
   EXPECT_EQ(cutOf(top), DRAPE_GARMENT_FIT_SKELETON);
+}
+
+// BY_KIND on a body shape too small for the person (Context::shapeFitsPerson): an adult's pose on a
+// 1.0 m body. The T-shirt and the dress are cut for the skeleton from the first pose (the
+// provisional fit, before either is placed on the person: one refit each and no step in the
+// shape's cut); a garment whose own cut is the shape's, and a caller's mesh, keep the shape's. A
+// shape that fits the person again (1.70 m) takes them back to the shape's cut; the trousers
+// stay cut for the skeleton throughout.
+TEST(CApiGarments, ByKindCutsForTheSkeletonWhenTheShapeIsTooSmallForThePerson) {
+  ContextPtr ctx = makeContext();
+  drape_body_shape small;
+  ASSERT_OK(drape_body_shape_init(&small));
+  small.height_m = 1.0f;
+  small.weight_kg = 22.0f;
+  ASSERT_OK(drape_context_set_body_shape(ctx.get(), &small));
+  drape_garment* top = addTemplateCut(ctx.get(), DRAPE_GARMENT_TSHIRT, DRAPE_GARMENT_CUT_BY_KIND);
+  drape_garment* dress = addTemplateCut(ctx.get(), DRAPE_GARMENT_DRESS, DRAPE_GARMENT_CUT_BY_KIND);
+  drape_garment* legs = addTemplateCut(ctx.get(), DRAPE_GARMENT_TROUSERS, DRAPE_GARMENT_CUT_BY_KIND);
+  drape_garment* kept = addTemplateCut(ctx.get(), DRAPE_GARMENT_TSHIRT, DRAPE_GARMENT_CUT_SHAPE);
+  ASSERT_TRUE(top && dress && legs && kept);
+  const drape_vec3 quad[4] = {{-0.1f, 1.1f, 2.3f}, {0.1f, 1.1f, 2.3f}, {0.1f, 1.3f, 2.3f}, {-0.1f, 1.3f, 2.3f}};
+  const uint32_t tris[6] = {0, 1, 2, 0, 2, 3};
+  drape_mesh_fit fit;
+  ASSERT_OK(drape_mesh_fit_init(&fit));
+  fit.unit_scale = 1.0f;
+  fit.facing = 1;
+  fit.source_floor_y_m = 0.0f;
+  fit.source_axis_z_m = 2.5f;
+  drape_garment* patch = nullptr;
+  ASSERT_OK(drape_context_add_garment_mesh(ctx.get(), quad, 4, tris, 6, &fit, nullptr, nullptr, &patch));
+  EXPECT_EQ(cutOf(top), DRAPE_GARMENT_FIT_SHAPE) << "no pose yet: nothing says the shape does not fit";
+  EXPECT_EQ(cutOf(dress), DRAPE_GARMENT_FIT_SHAPE);
+  const std::vector<drape_vec3> dressRest = restOf(dress);
+  const float dressHeight = extentY(dressRest);
+
+  ASSERT_OK(pushAndStep(ctx.get(), 0));
+  EXPECT_EQ(cutOf(top), DRAPE_GARMENT_FIT_SKELETON);
+  EXPECT_EQ(cutOf(dress), DRAPE_GARMENT_FIT_SKELETON);
+  EXPECT_EQ(cutOf(legs), DRAPE_GARMENT_FIT_SKELETON);
+  EXPECT_EQ(cutOf(kept), DRAPE_GARMENT_FIT_SHAPE) << "its own cut is the shape's";
+  EXPECT_EQ(cutOf(patch), DRAPE_GARMENT_FIT_SHAPE) << "a mesh cannot be made again for another body";
+  for (drape_garment* g : {top, dress, legs}) EXPECT_EQ(refitsOf(g), 1u) << "cut again before its first step";
+  EXPECT_EQ(refitsOf(kept), 0u);
+  EXPECT_GT(extentY(restOf(dress)), 1.3f * dressHeight) << "cut for the adult's bones, not the 1.0 m body";
+
+  for (int i = 1; i < kPastTheRecut; ++i) ASSERT_OK(pushAndStep(ctx.get(), i));
+  EXPECT_EQ(cutOf(top), DRAPE_GARMENT_FIT_SKELETON) << "the calibration keeps the skeleton's cut";
+  EXPECT_EQ(cutOf(dress), DRAPE_GARMENT_FIT_SKELETON);
+  drape_body_shape fits;
+  ASSERT_OK(drape_body_shape_init(&fits));  // the default 1.70 m, 65 kg
+  ASSERT_OK(drape_context_set_body_shape(ctx.get(), &fits));
+  EXPECT_EQ(cutOf(top), DRAPE_GARMENT_FIT_SHAPE) << "the new shape fits the person";
+  EXPECT_EQ(cutOf(dress), DRAPE_GARMENT_FIT_SHAPE);
+  EXPECT_EQ(cutOf(legs), DRAPE_GARMENT_FIT_SKELETON);
+  EXPECT_EQ(cutOf(kept), DRAPE_GARMENT_FIT_SHAPE);
+  for (int i = kPastTheRecut; i < kPastTheRecut + 5; ++i) ASSERT_OK(pushAndStep(ctx.get(), i));
+  for (drape_garment* g : {top, dress, legs, kept, patch}) EXPECT_TRUE(allFinite(snapshot(g)));
+  // Too small again: cut for the skeleton at once (the bones are known).
+  ASSERT_OK(drape_context_set_body_shape(ctx.get(), &small));
+  EXPECT_EQ(cutOf(top), DRAPE_GARMENT_FIT_SKELETON);
+  EXPECT_EQ(cutOf(dress), DRAPE_GARMENT_FIT_SKELETON);
+  // A garment added now is cut for the skeleton from the start.
+  drape_garment* skirt = addTemplateCut(ctx.get(), DRAPE_GARMENT_SKIRT, DRAPE_GARMENT_CUT_BY_KIND);
+  ASSERT_NE(skirt, nullptr);
+  EXPECT_EQ(cutOf(skirt), DRAPE_GARMENT_FIT_SKELETON);
+  // On the shape that fits from the start, the same garments keep the shape's cut (as
+  // ByKindCutsTrousersAndLongSleevesForTheSkeleton checks past the calibration).
+  ContextPtr fitting = makeContext();
+  drape_garment* shirt = addTemplateCut(fitting.get(), DRAPE_GARMENT_TSHIRT, DRAPE_GARMENT_CUT_BY_KIND);
+  ASSERT_NE(shirt, nullptr);
+  ASSERT_OK(pushAndStep(fitting.get(), 0));
+  EXPECT_EQ(cutOf(shirt), DRAPE_GARMENT_FIT_SHAPE);
+  EXPECT_EQ(refitsOf(shirt), 0u);
 }
 
 TEST(CApiGarments, CallerMeshAndObjGarments) {

@@ -55,7 +55,10 @@ void scaleSubtree(SkeletonPose& p, Joint from, float s) {
 
 // A person unlike the standard one: legs 15 % shorter, spine 10 % longer, shoulders 4 cm higher
 // (a Kinect v2 on Ges01 measures legs ~16 % shorter and the torso ~9 % longer than the standard
-// proportions), arms hanging 75 degrees down.
+// proportions), arms of the standard length hanging 75 degrees down. Of the size the shape fits
+// (its bones' median scale 1.0: Context::shapeFitsPerson), so the garments are cut for it at the
+// calibration; with the arms 10 % longer too the median was 1.1, a shape too small for a tracked
+// person (whose bones read ~15 % short), cut for the skeleton from the first pose.
 SkeletonPose otherPerson() {
   SkeletonPose p = restPose(standardShape(), 75.0f);
   for (Joint hip : {Joint::HipL, Joint::HipR}) {
@@ -66,6 +69,7 @@ SkeletonPose otherPerson() {
     p.position[static_cast<size_t>(idx(hip))] = h;
   }
   scaleSubtree(p, Joint::SpineMid, 1.1f);
+  for (Joint elbow : {Joint::ElbowL, Joint::ElbowR}) scaleSubtree(p, elbow, 1.0f / 1.1f);
   for (Joint s : {Joint::ShoulderL, Joint::ShoulderR}) {
     SkeletonPose q = p;
     const Vec3 up(0.0f, 0.04f, 0.0f);

@@ -197,4 +197,19 @@ SkeletonPose TorsoAverage::mean() const {
   return p;
 }
 
+float boneScaleAgainstShape(const ResolvedShape& shape, const std::array<float, kBoneCount>& lengths) {
+  const SkeletonPose rest = restPose(shape);
+  std::array<float, kBoneCount> ratio{};
+  int n = 0;
+  for (int b = 0; b < kBoneCount; ++b) {
+    const float l = lengths[static_cast<size_t>(b)];
+    const float r = (rest.position[static_cast<size_t>(boneChild(b))] - rest.position[static_cast<size_t>(boneParent(b))]).norm();
+    if (!(l >= 0.01f) || !std::isfinite(l) || !(r >= 0.01f)) continue;
+    ratio[static_cast<size_t>(n++)] = l / r;
+  }
+  if (n == 0) return 1.0f;
+  std::nth_element(ratio.begin(), ratio.begin() + n / 2, ratio.begin() + n);
+  return ratio[static_cast<size_t>(n / 2)];
+}
+
 }  // namespace drape

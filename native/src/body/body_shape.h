@@ -52,6 +52,13 @@ SkeletonPose restPose(const ResolvedShape& shape, float arm_down_deg = 35.0f);
 SkeletonPose restPoseWithBones(const ResolvedShape& shape, float arm_down_deg,
                                const std::array<float, kBoneCount>& lengths, const SkeletonPose* torso = nullptr);
 
+// How the person's bones compare in size with the shape's standard proportions: the median over
+// the bones of (measured length / the length in restPose(shape)), leaving out lengths that are not
+// finite or under 1 cm (bones the sensor has not seen); 1 when no bone is usable. About 0.9 for
+// the shared Kinect and CMU takes on the default 1.70 m body; about 1.5 for an adult tracked on a
+// 1.0 m body and 0.7 on a 2.2 m one (a shape the host set for someone else).
+float boneScaleAgainstShape(const ResolvedShape& shape, const std::array<float, kBoneCount>& lengths);
+
 // The person's torso geometry averaged over many poses (the tracker's calibration window): the
 // direction of each torso bone (spine, neck, head, hip and shoulder joints) in the frame of the
 // pelvis, so one bent or noisy frame does not shape the garments. mean() is a pose with those

@@ -223,13 +223,13 @@ drape::TopologyParams topologyFrom(const drape_garment_desc& d) {
 
 // Hands out a handle for a garment dressed on the context's rest body for `cut` (null: `err` says why).
 drape_result adoptCreated(const char* fn, Context& ctx, Context::RestCut cut, std::unique_ptr<GarmentSim> g,
-                          const std::string& err, drape_garment** out) {
+                          const std::string& err, drape_garment** out, bool shape_while_it_fits = false) {
   if (!g) return fail(DRAPE_ERROR_INVALID_ARGUMENT, std::string(fn) + ": " + err);
   GarmentSim* raw = g.get();
   void* token = registerHandle(HandleKind::Garment, raw);
   raw->api_token = token;
   raw->api_owner = &ctx;
-  ctx.adoptGarment(std::move(g), cut);
+  ctx.adoptGarment(std::move(g), cut, shape_while_it_fits);
   *out = static_cast<drape_garment*>(token);
   return DRAPE_OK;
 }
@@ -238,7 +238,7 @@ drape_result adoptCreated(const char* fn, Context& ctx, Context::RestCut cut, st
 drape_result adopt(const char* fn, Context& ctx, const drape::GarmentMesh& mesh, const drape_garment_desc& d,
                    const drape::GarmentSimParams& sim, drape_garment** out, bool cut_from_dressed) {
   std::string err;
-  const Context::RestCut cut = ctx.cutFor(d.cut, /*limbs_must_fit=*/false);
+  const Context::RestCut cut = ctx.cutFor(d.cut, /*limbs_must_fit=*/false, /*template_kind=*/false);
   auto g = GarmentSim::create(mesh, topologyFrom(d), static_cast<drape::ClothSolverKind>(d.solver), sim,
                               d.dress_time_s, ctx.restBody(cut), ctx.restEllipsoids(cut), ctx.restEllipsoidGroups(cut),
                               err, cut_from_dressed);
@@ -251,7 +251,7 @@ drape_result addFitted(const char* fn, Context& ctx, const drape::ObjMesh& obj, 
   if (drape_result r = toFitParams(fn, fit, fp)) return r;
   drape::GarmentMesh mesh;
   std::string err;
-  if (!drape::fitObjGarment(obj, fp, ctx.restBody(ctx.cutFor(d.cut, /*limbs_must_fit=*/false)), mesh, err))
+  if (!drape::fitObjGarment(obj, fp, ctx.restBody(ctx.cutFor(d.cut, /*limbs_must_fit=*/false, /*template_kind=*/false)), mesh, err))
     return fail(DRAPE_ERROR_INVALID_ARGUMENT, std::string(fn) + ": " + err);
   return adopt(fn, ctx, mesh, d, sim, out, /*cut_from_dressed=*/true);
 }
@@ -348,11 +348,12 @@ DRAPE_API drape_result DRAPE_CALL drape_context_add_garment_template(drape_conte
     tp.ease_m = t.ease_m;
     tp.length_scale = t.length_scale;
     std::string err;
-    const Context::RestCut cut = ctx->cutFor(d.cut, drape::garmentReachesLimbEnds(tp.kind));
+    const bool limbs = drape::garmentReachesLimbEnds(tp.kind);
+    const Context::RestCut cut = ctx->cutFor(d.cut, limbs);
     auto g = GarmentSim::createTemplate(tp, topologyFrom(d), static_cast<drape::ClothSolverKind>(d.solver), sim,
                                         d.dress_time_s, ctx->restBody(cut), ctx->restEllipsoids(cut),
                                         ctx->restEllipsoidGroups(cut), err);
-    return adoptCreated(fn, *ctx, cut, std::move(g), err, out_garment);
+    return adoptCreated(fn, *ctx, cut, std::move(g), err, out_garment, ctx->cutFollowsShapeFit(d.cut, limbs));
   });
 }
 

@@ -156,41 +156,72 @@ SkeletonPose Context::garmentRestPose(RestCut cut) const {
                                           : restPose(shape_, kGarmentRestArmDownDeg);
 }
 
-void Context::fitGarmentsToSkeleton() {
+bool Context::shapeFitsPerson(const std::array<float, kBoneCount>& bones) const {
+  return boneScaleAgainstShape(shape_, bones) <= kTrackedBoneScale * kShapeMisfit;
+}
+
+void Context::fitGarmentsToSkeleton(bool provisional) {
   // The garments cut for the skeleton so far were cut for other proportions (the shape's standard
   // ones, or a previous calibration's): cut them again for this person, when their rest pose is
-  // another. Should one fail to dress on that body, every garment stays as it was, on the previous
-  // rest body, until the next calibration. Garments cut for the shape are not touched.
-  fittedCalibration_ = tracker_.calibrationCount();
+  // another. Those cut for the shape while it fits are cut for the skeleton when it does not (and
+  // stay so until a shape change decides again). Should one fail to dress on that body, every
+  // garment stays as it was, on the previous rest body, until the next calibration.
+  const std::array<float, kBoneCount>& bones = tracker_.boneLengths();
+  const bool fits = shapeFitsPerson(bones);
+  if (provisional && fits) return;  // the calibration cuts the skeleton's garments
   const SkeletonPose torso = torsoAverage_.empty() ? tracker_.pose() : torsoAverage_.mean();
-  torsoAverage_.clear();  // the next calibration (a tracker reset) averages its own window
-  const SkeletonPose fitted = restPoseWithBones(shape_, kGarmentRestArmDownDeg, tracker_.boneLengths(), &torso);
+  if (!provisional) {
+    fittedCalibration_ = tracker_.calibrationCount();
+    torsoAverage_.clear();  // the next calibration (a tracker reset) averages its own window
+  }
+  shapeFits_ = fits;
+  const SkeletonPose fitted = restPoseWithBones(shape_, kGarmentRestArmDownDeg, bones, &torso);
   const SkeletonPose current = garmentRestPose(kCutSkeleton);
   float moved = 0.0f;
   for (int j = 0; j < kJointCount; ++j)
     moved = std::max(moved, (fitted.position[static_cast<size_t>(j)] - current.position[static_cast<size_t>(j)]).norm());
-  if (!(moved >= kRefitBelowM)) return;  // this person has the proportions the garments were cut for
+  // A garment to cut again: one cut for the skeleton, when this person's proportions are not the
+  // ones it was cut for; one cut for a shape that does not fit.
+  auto recutsTo = [&](const GarmentCut& c) {
+    return (c.cut == kCutSkeleton && moved >= kRefitBelowM) || (c.cut == kCutShape && c.shape_while_it_fits && !fits);
+  };
+  if (std::none_of(garmentCuts_.begin(), garmentCuts_.end(), recutsTo)) {
+    if (moved >= kRefitBelowM) {  // no garment cut for the skeleton yet: those added later are
+      fit_ = BoneFit{true, bones, torso};
+      rest_[kCutSkeleton].body.reset();
+      if (contextCut() == kCutSkeleton) proxyBounds_.clear();
+    }
+    return;
+  }
   // An earlier calibration's recut still dressing is replaced by this one's; the garments are still
   // on the cut before it, so that is the one to go back to.
   if (recuts_.empty()) fitBeforeRecut_ = fit_;
   recuts_.clear();
-  fit_ = BoneFit{true, tracker_.boneLengths(), torso};
+  fit_ = BoneFit{true, bones, torso};
   rest_[kCutSkeleton].body.reset();
   // The replacements, made now and dressed over the next steps (advanceRecuts): all of them or,
-  // when one cannot be made on the new body, none.
+  // when one cannot be made on the new body, none. A garment not yet stepped (not yet placed on
+  // the person: the provisional fit at the first pose) is dressed now and swapped in before its
+  // first step, so it is never seen in the cut that does not fit.
+  std::vector<Recut> now;
   for (size_t i = 0; i < garments_.size(); ++i) {
-    if (garmentCuts_[i] != kCutSkeleton) continue;
+    if (!recutsTo(garmentCuts_[i])) continue;
     Recut r;
     r.garment = garments_[i].get();
+    const bool placed = r.garment->steps() > 0;
     std::string why;
-    r.fresh = r.garment->refitted(restBody(kCutSkeleton), restEllipsoids(kCutSkeleton),
-                                  restEllipsoidGroups(kCutSkeleton), why, /*remake_template=*/true, &r.dressing);
+    r.fresh = r.garment->refitted(restBody(kCutSkeleton), restEllipsoids(kCutSkeleton), restEllipsoidGroups(kCutSkeleton),
+                                  why, /*remake_template=*/true, placed ? &r.dressing : nullptr);
     if (!r.fresh) {
       recuts_.clear();
       restoreFitBefore();
       return;
     }
-    recuts_.push_back(std::move(r));
+    (placed ? recuts_ : now).push_back(std::move(r));
+  }
+  for (Recut& r : now) {
+    swapIn(*r.garment, std::move(*r.fresh));
+    if (GarmentCut* c = cutEntry(r.garment)) c->cut = r.cut;
   }
   // The adaptive pipeline's ellipsoid bounds come from the context's own cut's rest body.
   if (contextCut() == kCutSkeleton) proxyBounds_.clear();
@@ -222,6 +253,7 @@ void Context::advanceRecuts() {
     std::string unused;
     r.fresh->setParams(r.garment->params(), unused);  // the host's parameters of now (validated when set)
     swapIn(*r.garment, std::move(*r.fresh));
+    if (GarmentCut* c = cutEntry(r.garment)) c->cut = r.cut;
   }
   recuts_.clear();
   reachDirty_ = true;
@@ -229,17 +261,28 @@ void Context::advanceRecuts() {
 }
 
 bool Context::refitGarments(std::string& err) {
+  // The new shape may fit the person's fitted bones where the old one did not, or the other way:
+  // the garments cut for the shape while it fits take the cut that says, made again as their
+  // template on that cut's rest body; the others are carried to their cut's new rest body.
+  const bool fits = !fit_.on || shapeFitsPerson(fit_.bones);
   std::vector<std::unique_ptr<GarmentSim>> refits(garments_.size());
+  std::vector<RestCut> cuts(garments_.size());
   for (size_t i = 0; i < garments_.size(); ++i) {
-    const RestCut cut = garmentCuts_[i];
+    const GarmentCut& c = garmentCuts_[i];
+    cuts[i] = c.shape_while_it_fits ? (fits ? kCutShape : kCutSkeleton) : c.cut;
     std::string why;
-    refits[i] = garments_[i]->refitted(restBody(cut), restEllipsoids(cut), restEllipsoidGroups(cut), why);
+    refits[i] = garments_[i]->refitted(restBody(cuts[i]), restEllipsoids(cuts[i]), restEllipsoidGroups(cuts[i]), why,
+                                       /*remake_template=*/cuts[i] != c.cut);
     if (!refits[i]) {
       err = "garment " + std::to_string(i) + " could not be dressed on the new body (" + why + ")";
       return false;
     }
   }
-  for (size_t i = 0; i < garments_.size(); ++i) swapIn(*garments_[i], std::move(*refits[i]));
+  for (size_t i = 0; i < garments_.size(); ++i) {
+    swapIn(*garments_[i], std::move(*refits[i]));
+    garmentCuts_[i].cut = cuts[i];
+  }
+  shapeFits_ = fits;
   return true;
 }
 
@@ -357,6 +400,14 @@ drape_result Context::update(std::string& err) {
   // The torso over the calibration window, for the garments' cut (fitGarmentsToSkeleton).
   // Any garment may be cut for the skeleton (drape_garment_desc.cut), one added later too.
   if (newPose && !tracker_.calibrated()) torsoAverage_.add(pose);
+  if (newPose) {  // the provisional fit's count (fitGarmentsToSkeleton)
+    if (tracker_.calibrated()) {
+      uncalibratedPoses_ = 0;
+      provisionalFitDone_ = false;
+    } else {
+      ++uncalibratedPoses_;
+    }
+  }
   finishFrameCounters();
   skips_.updates = updates_;
   // A body that moved wakes the garments before anything is built for the frame.
@@ -427,10 +478,10 @@ FidelityReport Context::measureFidelity() {
 
 namespace drape {
 
-Context::RestCut Context::cutFor(int32_t garment_cut, bool limbs_must_fit) const {
+Context::RestCut Context::cutFor(int32_t garment_cut, bool limbs_must_fit, bool template_kind) const {
   if (garment_cut == DRAPE_GARMENT_CUT_SHAPE) return kCutShape;
   if (garment_cut == DRAPE_GARMENT_CUT_SKELETON) return kCutSkeleton;
-  if (garment_cut == DRAPE_GARMENT_CUT_BY_KIND && limbs_must_fit) return kCutSkeleton;
+  if (garment_cut == DRAPE_GARMENT_CUT_BY_KIND && (limbs_must_fit || (template_kind && !shapeFits_))) return kCutSkeleton;
   return contextCut();
 }
 
@@ -458,13 +509,19 @@ const std::vector<uint8_t>& Context::restEllipsoidGroups(RestCut cut) { return r
 
 const std::vector<Ellipsoid>& Context::restEllipsoids(RestCut cut) { return restSlot(cut).proxies.ellipsoids(); }
 
-GarmentSim* Context::adoptGarment(std::unique_ptr<GarmentSim> garment, RestCut cut) {
+Context::GarmentCut* Context::cutEntry(const GarmentSim* garment) {
+  for (size_t i = 0; i < garments_.size(); ++i)
+    if (garments_[i].get() == garment) return &garmentCuts_[i];
+  return nullptr;
+}
+
+GarmentSim* Context::adoptGarment(std::unique_ptr<GarmentSim> garment, RestCut cut, bool shape_while_it_fits) {
   ReachParams rp;
   rp.margin_m = options_.reach_margin_m;
   std::vector<ReachSphere> reach = garmentReach(*garment, rp);
   garmentCuts_.reserve(garments_.size() + 1);  // first: the two lists stay the same length
   garments_.push_back(std::move(garment));
-  garmentCuts_.push_back(cut);
+  garmentCuts_.push_back(GarmentCut{cut, shape_while_it_fits});
   adaptive_.addGarment(garments_.back().get(), std::move(reach));
   reachDirty_ = true;
   applyBackend(*garments_.back());
@@ -513,7 +570,12 @@ drape_result Context::beginStep(float dt, std::string& err) {
   stepT0_ = Clock::now();
   // A recut dresses from the step after the calibration's, which makes the replacements.
   advanceRecuts();
-  if (tracker_.calibrated() && tracker_.calibrationCount() != fittedCalibration_) fitGarmentsToSkeleton();
+  if (tracker_.calibrated() && tracker_.calibrationCount() != fittedCalibration_) {
+    fitGarmentsToSkeleton(/*provisional=*/false);
+  } else if (!tracker_.calibrated() && !provisionalFitDone_ && uncalibratedPoses_ >= kProvisionalFitPoses) {
+    provisionalFitDone_ = true;
+    fitGarmentsToSkeleton(/*provisional=*/true);
+  }
   // Woken or new garments, or new options, since the frame's ellipsoids were built.
   if (reachDirty_ && updated_) buildProxies(tracker_.pose());
   const std::vector<Ellipsoid>& now = proxies_.ellipsoids();
@@ -536,7 +598,7 @@ drape_result Context::beginStep(float dt, std::string& err) {
   placement_[kCutSkeleton].aim(this, kCutSkeleton);
   for (size_t i = 0; i < garments_.size(); ++i) {
     const std::unique_ptr<GarmentSim>& g = garments_[i];
-    g->setPlacementPath(&placement_[garmentCuts_[i]]);
+    g->setPlacementPath(&placement_[garmentCuts_[i].cut]);
     if (options_.sleep && adaptive_.asleep(g.get())) {
       g->markSkipped();
       ++slept;
@@ -604,7 +666,7 @@ drape_result Context::stepContexts(Context* const* contexts, size_t count, float
 
 Context::RestCut Context::cutOf(const GarmentSim& garment) const {
   for (size_t i = 0; i < garments_.size(); ++i)
-    if (garments_[i].get() == &garment) return garmentCuts_[i];
+    if (garments_[i].get() == &garment) return garmentCuts_[i].cut;
   return contextCut();
 }
 

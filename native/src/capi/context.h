@@ -51,8 +51,27 @@ class Context {
   enum RestCut : int { kCutShape = 0, kCutSkeleton = 1 };
   // A garment desc's cut (drape_garment_cut, validated) as a RestCut: CONTEXT follows garment_fit;
   // BY_KIND is the skeleton's for a garment whose limbs must fit (limbs_must_fit: trousers and
-  // long-sleeve templates), else CONTEXT.
-  RestCut cutFor(int32_t garment_cut, bool limbs_must_fit) const;
+  // long-sleeve templates), else CONTEXT, except that a template (template_kind) takes the
+  // skeleton's once the tracked bones say the shape does not fit the person (shapeFitsPerson):
+  // only a template can be made again for another body when the shape's fit changes.
+  RestCut cutFor(int32_t garment_cut, bool limbs_must_fit, bool template_kind = true) const;
+  // Whether a template garment with this desc cut follows that rule through shape changes and
+  // calibrations (BY_KIND, its limbs need not fit, the context cuts for the shape): adoptGarment's
+  // shape_while_it_fits.
+  bool cutFollowsShapeFit(int32_t garment_cut, bool limbs_must_fit) const {
+    return garment_cut == DRAPE_GARMENT_CUT_BY_KIND && !limbs_must_fit && contextCut() == kCutShape;
+  }
+  // Whether the body shape fits a person with these bone lengths (SkeletonTracker::boneLengths):
+  // their size against the shape's proportions (boneScaleAgainstShape, body/body_shape.h) within
+  // kShapeMisfit of kTrackedBoneScale. Why: a host that sets a shape for someone else (or leaves
+  // the default 1.70 m for a child) got garments cut for that body; a dress cut for 1.0 m on an
+  // adult's skeleton stretched to 3x between its collar and waist pins (P99 1.98), a T-shirt cut
+  // for 2.2 m hung off an adult (P99 1.41); cut for the bones, 0.06 and 0.10 (docs/garments.md,
+  // "A shape that does not fit the person").
+  static constexpr float kTrackedBoneScale = 0.85f;  // Kinect and mocap takes on a fitting shape: 0.82-0.94
+  static constexpr float kShapeMisfit = 1.25f;
+  bool shapeFitsPerson(const std::array<float, kBoneCount>& bones) const;
+  bool shapeFitsPerson() const { return shapeFits_; }
   // The cut a garment of this context was made for (contextCut() for one that is not).
   RestCut cutOf(const GarmentSim& garment) const;
   RestCut contextCut() const {
@@ -69,7 +88,8 @@ class Context {
   const std::vector<Ellipsoid>& restEllipsoids() { return restEllipsoids(contextCut()); }
   const std::vector<uint8_t>& restEllipsoidGroups() { return restEllipsoidGroups(contextCut()); }
   // Takes ownership; the garment is dressed already (GarmentSim::create with restBody(cut)).
-  GarmentSim* adoptGarment(std::unique_ptr<GarmentSim> garment, RestCut cut);
+  // shape_while_it_fits: cutFollowsShapeFit (the garment changes cut when the shape's fit does).
+  GarmentSim* adoptGarment(std::unique_ptr<GarmentSim> garment, RestCut cut, bool shape_while_it_fits = false);
   GarmentSim* adoptGarment(std::unique_ptr<GarmentSim> garment) { return adoptGarment(std::move(garment), contextCut()); }
   // Destroys it; false when it is not this context's.
   bool removeGarment(const GarmentSim* garment);
@@ -136,7 +156,16 @@ class Context {
   TorsoAverage torsoAverage_;  // the torso over the calibration window
   uint32_t fittedCalibration_ = 0;  // the tracker's calibrationCount() last seen
   SkeletonPose garmentRestPose(RestCut cut) const;
-  void fitGarmentsToSkeleton();
+  // The skeleton's calibration (or, provisional, the bones kProvisionalFitPoses poses into it):
+  // garments cut for the skeleton are cut again for these bones, and those cut for the shape
+  // while it fits are cut for the skeleton when it does not. A provisional fit acts only on a
+  // shape that does not fit: garments cut for a body of another size would spend the calibration
+  // window (a second) stretched or hanging off; the calibration cuts them again for its bones.
+  void fitGarmentsToSkeleton(bool provisional);
+  static constexpr int kProvisionalFitPoses = 1;
+  int uncalibratedPoses_ = 0;     // new poses since the tracker last started calibrating
+  bool provisionalFitDone_ = false;
+  bool shapeFits_ = true;         // shapeFitsPerson(bones) of the bones fitted last
   // A recut in progress (the skeleton's calibration): each garment cut for the skeleton has its
   // replacement, made on the new rest body, dressed kRecutFramesPerStep frames a step beside it
   // (GarmentSim::Dressing) instead of all in the calibration's step; the step after the last one
@@ -148,6 +177,7 @@ class Context {
     GarmentSim* garment = nullptr;
     std::unique_ptr<GarmentSim> fresh;
     GarmentSim::Dressing dressing;
+    RestCut cut = kCutSkeleton;  // the garment's cut once swapped in
   };
   std::vector<Recut> recuts_;
   BoneFit fitBeforeRecut_;
@@ -161,7 +191,13 @@ class Context {
   // A garment takes over its new cut (GarmentSim::replaceWith), with its reach and backend.
   void swapIn(GarmentSim& garment, GarmentSim&& fresh);
   std::vector<std::unique_ptr<GarmentSim>> garments_;
-  std::vector<RestCut> garmentCuts_;  // garments_[i]'s cut
+  // garments_[i]'s cut, and whether it is the shape's only while the shape fits the person.
+  struct GarmentCut {
+    RestCut cut = kCutShape;
+    bool shape_while_it_fits = false;
+  };
+  std::vector<GarmentCut> garmentCuts_;
+  GarmentCut* cutEntry(const GarmentSim* garment);
   std::vector<Ellipsoid> stepEllipsoids_;  // the ellipsoids at the end of the last step
   // The way from each cut's rest pose into the pose now, for the garments placed this step
   // (cloth/placement_path.h; built only when one asks: capi/context_placement.cpp).
