@@ -471,6 +471,7 @@ int run(int argc, char** argv) {
       st.nonfinite += replay::countNonFinite(rest);
       st.stretch.setRest(rest);
       st.refits = gs.refits;
+      st.garment_fit = gs.cut;  // a garment cut by kind may have changed cut (a shape too small)
     }
     st.nan_resets += gs.nan_reset ? 1u : 0u;
 

@@ -264,7 +264,9 @@ namespace {
 std::string fitText(const ReplayStats& s) {
   const bool skeleton = s.garment_fit == DRAPE_GARMENT_FIT_SKELETON;
   std::string text = skeleton ? "the person's skeleton once calibrated" : "the body shape's standard proportions";
-  if (s.garment_fit_by_kind) text += skeleton ? " (by its kind: limbs to the wrists or ankles)" : " (by its kind)";
+  const bool limbs = s.garment_kind == "trousers" || s.garment_kind == "longsleeve";
+  if (s.garment_fit_by_kind && !skeleton) text += " (by its kind)";
+  else if (s.garment_fit_by_kind) text += limbs ? " (by its kind: limbs to the wrists or ankles)" : " (by its kind: the body shape is too small for this person)";
   else if (skeleton) text += " (--garment-fit skeleton)";
   return text;
 }

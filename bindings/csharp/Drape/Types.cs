@@ -118,7 +118,10 @@ namespace Drape
         /// <summary>DRAPE_GARMENT_CUT_BY_KIND: trousers and long-sleeve templates as <see cref="Skeleton"/>, every
         /// other garment as <see cref="Context"/>: legs and sleeves that reach the ankles and wrists stay round
         /// the person's limbs only when cut to their lengths, the shorter garments stretch less on the shape's
-        /// cut (docs/garments.md, "Cut by kind"). The default (<see cref="GarmentDesc.CreateDefault"/>).</summary>
+        /// cut (docs/garments.md, "Cut by kind"). When the tracked bones say the body shape is too small for the
+        /// person (an adult on a 1.0-1.3 m shape), the T-shirt, skirt and dress templates are cut for the skeleton
+        /// too, from the first pose (docs/garments.md, "A shape too small for the person"). The default
+        /// (<see cref="GarmentDesc.CreateDefault"/>).</summary>
         ByKind = 3,
     }
 
@@ -526,7 +529,8 @@ namespace Drape
         public float DressTimeS;
         /// <summary>cut (int32_t in C): what proportions this garment is cut for; default
         /// <see cref="GarmentCut.ByKind"/> (trousers and long sleeves for the person's skeleton, the rest as the
-        /// context's <see cref="ContextDesc.GarmentFit"/>); <see cref="GarmentStats.Cut"/> says what it got.</summary>
+        /// context's <see cref="ContextDesc.GarmentFit"/> unless the body shape is too small for the person);
+        /// <see cref="GarmentStats.Cut"/> says what it got.</summary>
         public GarmentCut Cut;
 
         /// <summary>The library's defaults (drape_garment_desc_init).</summary>

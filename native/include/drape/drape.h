@@ -450,7 +450,14 @@ typedef enum drape_garment_cut {
    * sleeves that reach the ankles and wrists stay round the person's limbs only when cut to the
    * person's limb lengths (on the shared Kinect takes the shape's trousers hang past the feet in
    * every frame, on the CMU takes the long sleeves past the hands), while the shorter garments keep
-   * less stretch on the shape's cut. Default (drape_garment_desc_init). */
+   * less stretch on the shape's cut. Except: when the tracked bones say the body shape is too small
+   * for the person (their median length over 1.25 x 0.85 times the shape's standard proportions:
+   * trackers read bones ~15 % short, so e.g. an adult on a 1.0-1.3 m shape), the T-shirt, skirt and
+   * dress templates are cut for the skeleton too, and every garment cut for the skeleton is cut for
+   * the bones of the first pose at once (before its first step if it has not stepped yet), then again
+   * at the calibration; a shape change decides again (a shape that fits takes them back to the
+   * shape's cut). Cut for a 1.0 m shape, a dress on an adult stretched to three times its length
+   * (docs/garments.md, "A shape too small for the person"). Default (drape_garment_desc_init). */
   DRAPE_GARMENT_CUT_BY_KIND = 3,
   DRAPE_GARMENT_CUT_FORCE32 = 0x7fffffff
 } drape_garment_cut;
