@@ -97,6 +97,16 @@ inline RecordingFrame kinect2FromPose(const SkeletonPose& pose, double time_s) {
   return f;
 }
 
+// The same Kinect v2 frame with the knees only inferred. A first pose whose legs the sensor guesses
+// has the context wait for the calibration to cut the garments cut for the skeleton (its
+// provisional fit at the first pose asks for every limb joint tracked: capi/context.h): the way
+// the tests of the calibration's recut still get one on synthetic poses, whose bones never change.
+inline RecordingFrame withGuessedKnees(RecordingFrame f) {
+  for (size_t k : {size_t{13}, size_t{17}})  // Kinect v2 KneeLeft, KneeRight
+    if (k < f.joints.size()) f.joints[k].state = TrackingState::Inferred;
+  return f;
+}
+
 // Replays the whole recording (frame dt from its timestamps, first frame 1/30 s) with `garment`
 // in `ctx`, measuring after every step. `per_frame` (optional) sees each frame index.
 inline SceneSummary replay(Context& ctx, GarmentSim& garment, const Recording& rec, std::string& err,

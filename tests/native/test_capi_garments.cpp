@@ -461,7 +461,13 @@ TEST(CApiGarments, ByKindCutsTrousersAndLongSleevesForTheSkeleton) {
   drape_garment* patch = nullptr;
   ASSERT_OK(drape_context_add_garment_mesh(ctx.get(), quad, 4, tris, 6, &fit, &d, nullptr, &patch));
   EXPECT_EQ(cutOf(patch), DRAPE_GARMENT_FIT_SHAPE);
-  for (int i = 0; i < kPastTheRecut; ++i) ASSERT_OK(pushAndStep(ctx.get(), i));
+  // The first pose, every limb joint tracked: the trousers and the long sleeves are cut for its
+  // bones before their first step (the provisional fit); the calibration finds the same bones in
+  // these synthetic poses and cuts nothing again.
+  ASSERT_OK(pushAndStep(ctx.get(), 0));
+  for (size_t k = 0; k < garments.size(); ++k)
+    EXPECT_EQ(refitsOf(garments[k]), cases[k].cut == DRAPE_GARMENT_FIT_SKELETON ? 1u : 0u) << "kind " << cases[k].kind;
+  for (int i = 1; i < kPastTheRecut; ++i) ASSERT_OK(pushAndStep(ctx.get(), i));
   for (size_t k = 0; k < garments.size(); ++k) {
     EXPECT_EQ(refitsOf(garments[k]), cases[k].cut == DRAPE_GARMENT_FIT_SKELETON ? 1u : 0u) << "kind " << cases[k].kind;
     EXPECT_TRUE(allFinite(snapshot(garments[k])));

@@ -112,13 +112,16 @@ TEST(GarmentOnCloseRange, LowerBodyGarmentsComeThroughTheGuessedLegs) {
 }
 
 // Trousers as drape_garment_desc_init cuts them (DRAPE_GARMENT_CUT_BY_KIND) on the Kinect takes:
-// cut for the shape's standard legs until the tracker calibrates, their hems hang past the feet
-// (the Kinect measures these people's legs 16 % shorter); cut again for the person's legs (a recut
-// dressed over the steps after the calibration, capi/context.h), they stay on the legs to the end
-// of the take. On the shape's cut they were off in every frame (docs/garments.md, "Cut by kind").
+// cut for the person's legs from the first frame (the provisional fit of the first pose, whose
+// limbs the sensor sees: capi/context.h), then again at the calibration when its bones move the
+// rest pose by 1 cm or more; they are on the legs in every measured frame. Cut for the shape's
+// standard legs until the calibration (before 2026-11-29's thirteenth session), their hems hung
+// past the feet for the first second (the Kinect measures these people's legs 16 % shorter), and on
+// the shape's cut throughout they were off in every frame (docs/garments.md, "Cut by kind" and "Cut
+// for the first pose").
 class TrousersByKindOnRecording : public ::testing::TestWithParam<const char*> {};
 
-TEST_P(TrousersByKindOnRecording, StayOnTheLegsOnceCutForThePerson) {
+TEST_P(TrousersByKindOnRecording, StayOnTheLegsFromTheFirstFrame) {
   DRAPE_REQUIRE_SHARED(path, GetParam());
   Recording rec;
   std::string err;
@@ -133,26 +136,24 @@ TEST_P(TrousersByKindOnRecording, StayOnTheLegsOnceCutForThePerson) {
                                          ctx.restBody(cut), ctx.restEllipsoids(cut), ctx.restEllipsoidGroups(cut), err);
   ASSERT_NE(made, nullptr) << err;
   GarmentSim* g = ctx.adoptGarment(std::move(made), cut);
-  // From the step after the recut's swap (calibration at the 30th push, then 15 dressing frames
-  // two a step, the swap, and a frame to settle), every third frame measured.
-  constexpr int kSettled = 30 + 8 + 1 + 1;
-  int measured = 0, off = 0, off_before = 0, measured_before = 0;
+  int measured = 0, off = 0;
+  uint32_t refitsAfterFirst = 0;
   double prev = rec.frames[0].time_s - 1.0 / 30.0;
   for (size_t f = 0; f < rec.frames.size(); ++f) {
     const RecordingFrame& fr = rec.frames[f];
     ASSERT_EQ(test::pushAndStep(ctx, rec, fr, fr.time_s, static_cast<float>(fr.time_s - prev), err), DRAPE_OK) << err;
     prev = fr.time_s;
+    if (f == 0) refitsAfterFirst = g->refits();
     if (f % 3 != 0) continue;
-    const bool after = static_cast<int>(f) >= kSettled;
-    const GarmentAccuracy a = ctx.measureGarment(*g);
-    (after ? measured : measured_before) += 1;
-    if (a.openings.off > 0) (after ? off : off_before) += 1;
+    ++measured;
+    if (ctx.measureGarment(*g).openings.off > 0) ++off;
   }
-  std::printf("[ figures  ] %s: trousers off in %d of %d measured frames before the recut, %d of %d after; refits %u\n",
-              GetParam(), off_before, measured_before, off, measured, g->refits());
-  EXPECT_EQ(g->refits(), 1u);
-  EXPECT_GT(measured, 30);
-  EXPECT_EQ(off, 0) << "a trouser leg off its leg after the recut";
+  std::printf("[ figures  ] %s: trousers off in %d of %d measured frames; cut again %u time(s) by the first step, %u in all\n",
+              GetParam(), off, measured, refitsAfterFirst, g->refits());
+  EXPECT_EQ(refitsAfterFirst, 1u) << "cut for the first pose before its first step";
+  EXPECT_LE(g->refits(), 2u) << "and at most once more, at the calibration";
+  EXPECT_GT(measured, 45);
+  EXPECT_EQ(off, 0) << "a trouser leg off its leg";
 }
 
 INSTANTIATE_TEST_SUITE_P(SharedData, TrousersByKindOnRecording,

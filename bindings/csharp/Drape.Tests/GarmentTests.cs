@@ -234,19 +234,18 @@ namespace Drape.Tests
             StepFrames(ctx, 15, 20);
             Assert.Equal(1u, g.Stats.Refits);  // calibrated at 30 frames: GarmentFit.Shape (default) keeps the cut
 
-            // Cut for the skeleton instead: a second refit once the tracker has calibrated.
+            // Cut for the skeleton instead: cut again for the person. The first pose has every limb joint
+            // tracked, so the garment is cut for its bones before its first step (the provisional fit); the
+            // calibration (30th frame) finds the same bones in these synthetic poses and cuts nothing more.
             ContextDesc d = ContextDesc.CreateDefault();
             d.GarmentFit = GarmentFit.Skeleton;
             using (var fitted = new Context(d))
             using (Garment f = fitted.AddGarment(Small()))
             {
-                StepFrames(fitted, 29);
                 Assert.Equal(0u, f.Stats.Refits);
-                // The 30th frame calibrates; the new cut is dressed two frames a step beside the old one
-                // (15 frames), then swapped in: refitted by the 40th step.
-                StepFrames(fitted, 2, 29);
-                Assert.Equal(0u, f.Stats.Refits);
-                StepFrames(fitted, 10, 31);
+                StepFrames(fitted, 1);
+                Assert.Equal(1u, f.Stats.Refits);
+                StepFrames(fitted, 44, 1);
                 Assert.Equal(1u, f.Stats.Refits);
                 ReadAndCheck(f);
             }
@@ -259,7 +258,7 @@ namespace Drape.Tests
                 skeleton.Cut = GarmentCut.Skeleton;
                 using Garment top = mixed.AddGarment(Small());
                 using Garment legs = mixed.AddGarment(Small(), skeleton);
-                StepFrames(mixed, 45);  // calibrated at the 30th, the new cut swapped in at the 39th
+                StepFrames(mixed, 45);  // cut for the first pose (its limbs tracked) before its first step
                 Assert.Equal(0u, top.Stats.Refits);
                 Assert.Equal(1u, legs.Stats.Refits);
                 ReadAndCheck(legs);
@@ -277,8 +276,9 @@ namespace Drape.Tests
         [Fact]
         public void ByKind_CutsTrousersAndLongSleevesForTheSkeleton()
         {
-            // GarmentCut.ByKind, the default: trousers and long sleeves are cut for the person's skeleton (cut again
-            // at the calibration) in a context that cuts for the shape; the T-shirt follows the context.
+            // GarmentCut.ByKind, the default: trousers and long sleeves are cut for the person's skeleton (for the
+            // first pose when its limbs are tracked, again at the calibration if its bones differ) in a context
+            // that cuts for the shape; the T-shirt follows the context.
             Assert.Equal(GarmentCut.ByKind, GarmentDesc.CreateDefault().Cut);
             using var ctx = new Context();
             using Garment trousers = ctx.AddGarment(Small(GarmentKind.Trousers));
@@ -287,7 +287,7 @@ namespace Drape.Tests
             Assert.Equal(GarmentFit.Skeleton, trousers.Stats.CutFit);
             Assert.Equal(GarmentFit.Skeleton, sleeves.Stats.CutFit);
             Assert.Equal(GarmentFit.Shape, top.Stats.CutFit);
-            StepFrames(ctx, 45);  // calibrated at the 30th, the new cuts swapped in at the 39th
+            StepFrames(ctx, 45);  // cut for the first pose; the calibration finds the same bones
             Assert.Equal(1u, trousers.Stats.Refits);
             Assert.Equal(1u, sleeves.Stats.Refits);
             Assert.Equal(0u, top.Stats.Refits);

@@ -153,7 +153,7 @@ namespace Drape.Tests
                 Message(dresser, "OnEnable");
                 Assert.True(dresser.enabled, string.Join("\n", UnityEngine.Debug.StandInLog));
                 Time.deltaTime = 1f / 30f;
-                for (int i = 0; i < 50; ++i) Message(dresser, "Update");  // calibrated at 30, recut by 39
+                for (int i = 0; i < 50; ++i) Message(dresser, "Update");  // cut for the first pose (or at 30, recut by 39)
                 Assert.True(dresser.Loop.FramesAccepted >= 31, $"{dresser.Loop.FramesAccepted} frames accepted");
                 refits.Add(dresser.Garment.Stats.Refits);
                 Message(dresser, "OnDisable");

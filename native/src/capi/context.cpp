@@ -168,7 +168,7 @@ void Context::fitGarmentsToSkeleton(bool provisional) {
   // garment stays as it was, on the previous rest body, until the next calibration.
   const std::array<float, kBoneCount>& bones = tracker_.boneLengths();
   const bool fits = shapeFitsPerson(bones);
-  if (provisional && fits) return;  // the calibration cuts the skeleton's garments
+  if (provisional && fits && !provisionalFitsFirstPose()) return;  // the calibration cuts them
   const SkeletonPose torso = torsoAverage_.empty() ? tracker_.pose() : torsoAverage_.mean();
   if (!provisional) {
     fittedCalibration_ = tracker_.calibrationCount();
@@ -225,6 +225,20 @@ void Context::fitGarmentsToSkeleton(bool provisional) {
   }
   // The adaptive pipeline's ellipsoid bounds come from the context's own cut's rest body.
   if (contextCut() == kCutSkeleton) proxyBounds_.clear();
+}
+
+bool Context::provisionalFitsFirstPose() const {
+  // Only garments that have not been placed on the person yet: recut now, they are never seen in
+  // the shape's proportions; one already worn would be recut twice (now and at the calibration),
+  // each a jump. And only from a pose whose limbs the sensor sees: a guessed leg (the close-range
+  // take's) gave trousers cut too short until the calibration.
+  for (size_t i = 0; i < garments_.size(); ++i)
+    if (garmentCuts_[i].cut == kCutSkeleton && garments_[i]->steps() > 0) return false;
+  const SkeletonPose& p = tracker_.pose();
+  for (Joint j : {Joint::ShoulderL, Joint::ElbowL, Joint::WristL, Joint::ShoulderR, Joint::ElbowR, Joint::WristR,
+                  Joint::HipL, Joint::KneeL, Joint::AnkleL, Joint::HipR, Joint::KneeR, Joint::AnkleR})
+    if (p.state[static_cast<size_t>(idx(j))] != TrackingState::Tracked) return false;
+  return true;
 }
 
 void Context::restoreFitBefore() {

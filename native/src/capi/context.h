@@ -156,12 +156,17 @@ class Context {
   TorsoAverage torsoAverage_;  // the torso over the calibration window
   uint32_t fittedCalibration_ = 0;  // the tracker's calibrationCount() last seen
   SkeletonPose garmentRestPose(RestCut cut) const;
-  // The skeleton's calibration (or, provisional, the bones kProvisionalFitPoses poses into it):
-  // garments cut for the skeleton are cut again for these bones, and those cut for the shape
-  // while it fits are cut for the skeleton when it does not. A provisional fit acts only on a
-  // shape that does not fit: garments cut for a body of another size would spend the calibration
-  // window (a second) stretched or hanging off; the calibration cuts them again for its bones.
+  // The skeleton's calibration (or, provisional, the bones of the first pose of a tracker that is
+  // calibrating): garments cut for the skeleton are cut again for these bones, and those cut for
+  // the shape while it fits are cut for the skeleton when it does not. The calibration cuts them
+  // again for its own bones when those move the rest pose by kRefitBelowM or more. A provisional
+  // fit acts on a shape that does not fit (garments cut for a body of another size would spend the
+  // calibration window stretched or hanging off), or when provisionalFitsFirstPose(): then the
+  // trousers and long sleeves are on the person from the first frame instead of hanging past the
+  // feet and hands for a second and jumping at the calibration's recut (docs/garments.md, "Cut
+  // for the first pose").
   void fitGarmentsToSkeleton(bool provisional);
+  bool provisionalFitsFirstPose() const;
   static constexpr int kProvisionalFitPoses = 1;
   int uncalibratedPoses_ = 0;     // new poses since the tracker last started calibrating
   bool provisionalFitDone_ = false;
