@@ -96,10 +96,12 @@ namespace Drape
     {
         /// <summary>DRAPE_GARMENT_FIT_SHAPE: the body shape's standard proportions only. The default.</summary>
         Shape = 0,
-        /// <summary>DRAPE_GARMENT_FIT_SKELETON: the tracked person's. Once the tracker has calibrated the bone
-        /// lengths, every garment whose <see cref="GarmentDesc.Cut"/> follows the context is cut again for
-        /// their bones and torso (GarmentStats.Refits counts it; particles and triangles stay, the rest
-        /// shape changes): made in the calibration's step, dressed two frames a step beside the old cut,
+        /// <summary>DRAPE_GARMENT_FIT_SKELETON: the tracked person's. At the first pose, when its limb joints are all
+        /// tracked and no such garment has stepped yet, the garments are cut for that pose's bones before their
+        /// first step; once the tracker has calibrated the bone lengths, every garment whose
+        /// <see cref="GarmentDesc.Cut"/> follows the context is cut again for their bones and torso when those
+        /// move its rest pose by 1 cm or more (GarmentStats.Refits counts it; particles and triangles stay, the
+        /// rest shape changes): made in the calibration's step, dressed two frames a step beside the old cut,
         /// swapped in 9 steps later with the default dress time.</summary>
         Skeleton = 1,
     }

@@ -144,16 +144,20 @@ typedef enum drape_garment_fit {
   /* The body shape's standard proportions (drape_context_set_body_shape), whatever the skeleton.
    * Default. */
   DRAPE_GARMENT_FIT_SHAPE = 0,
-  /* The tracked person's. Until the tracker has calibrated the bone lengths (calibration_frames),
-   * garments are cut for the shape's standard proportions; then every garment cut for the skeleton
-   * is cut again for this person: the rest pose takes their bone lengths and their torso's
+  /* The tracked person's. At the first pose of a calibrating tracker, when every limb joint of it
+   * is tracked and no such garment has stepped yet, the garments cut for the skeleton are cut for
+   * that pose's bones before their first step (and at any rate when the shape is too small for the
+   * person: DRAPE_GARMENT_CUT_BY_KIND); else they are cut for the shape's standard proportions until
+   * the tracker has calibrated the bone lengths (calibration_frames). At the calibration every
+   * garment cut for the skeleton is cut again for this person: the rest pose takes their bone lengths and their torso's
    * geometry (spine, hip and shoulder joints) averaged over the calibration window, template
    * garments are made again on it with their first layout, OBJ garments carried to it
    * (drape_garment_stats.refits counts it; particles and triangles stay, the rest shape changes).
    * The new cut is made in the calibration's step and dressed over the next steps (two 1/30 s
    * frames a step beside the old cut, which the host goes on seeing), then swapped in: with the
    * default dress time, 9 steps after the calibration's (drape_garment_desc.dress_time_s).
-   * No refit when the person's rest pose is within 1 cm of the standard one. Less stretch on most
+   * No refit when the person's rest pose is within 1 cm of the one the garments were cut for (the
+   * standard one, or the first pose's: docs/garments.md, "Cut for the first pose"). Less stretch on most
    * shared takes at 2 000 particles, more on some (skirts on the Kinect takes, coarse garments):
    * docs/garments.md. */
   DRAPE_GARMENT_FIT_SKELETON = 1,
