@@ -54,9 +54,10 @@ SkeletonPose restPoseWithBones(const ResolvedShape& shape, float arm_down_deg,
 
 // How the person's bones compare in size with the shape's standard proportions: the median over
 // the bones of (measured length / the length in restPose(shape)), leaving out lengths that are not
-// finite or under 1 cm (bones the sensor has not seen); 1 when no bone is usable. About 0.9 for
-// the shared Kinect and CMU takes on the default 1.70 m body; about 1.5 for an adult tracked on a
-// 1.0 m body and 0.7 on a 2.2 m one (a shape the host set for someone else).
+// finite or under 1 cm (bones the sensor has not seen); 1 when no bone is usable. 0.82-0.94 for
+// the shared Kinect and CMU takes on the default 1.70 m body (trackers read bones short), 1.0 for
+// a synthetic pose of the standard proportions; 1.40 for an adult Kinect take on a 1.0 m body and
+// 0.63 on a 2.2 m one (a shape the host set for someone else).
 float boneScaleAgainstShape(const ResolvedShape& shape, const std::array<float, kBoneCount>& lengths);
 
 // The person's torso geometry averaged over many poses (the tracker's calibration window): the

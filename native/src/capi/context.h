@@ -61,14 +61,16 @@ class Context {
   bool cutFollowsShapeFit(int32_t garment_cut, bool limbs_must_fit) const {
     return garment_cut == DRAPE_GARMENT_CUT_BY_KIND && !limbs_must_fit && contextCut() == kCutShape;
   }
-  // Whether the body shape fits a person with these bone lengths (SkeletonTracker::boneLengths):
-  // their size against the shape's proportions (boneScaleAgainstShape, body/body_shape.h) within
-  // kShapeMisfit of kTrackedBoneScale. Why: a host that sets a shape for someone else (or leaves
-  // the default 1.70 m for a child) got garments cut for that body; a dress cut for 1.0 m on an
-  // adult's skeleton stretched to 3x between its collar and waist pins (P99 1.98), a T-shirt cut
-  // for 2.2 m hung off an adult (P99 1.41); cut for the bones, 0.06 and 0.10 (docs/garments.md,
-  // "A shape that does not fit the person").
-  static constexpr float kTrackedBoneScale = 0.85f;  // Kinect and mocap takes on a fitting shape: 0.82-0.94
+  // Whether the body shape is not too small for a person with these bone lengths
+  // (SkeletonTracker::boneLengths): their size against the shape's proportions
+  // (boneScaleAgainstShape, body/body_shape.h) at most kShapeMisfit times kTrackedBoneScale, what
+  // trackers read on a shape that fits (their joints sit inside the body). Why: a host that sets a
+  // shape for someone else (a child's left on while an adult plays) got garments cut for that
+  // body; a dress cut for 1.0 m on an adult's skeleton stretched to 3x between its collar and
+  // waist pins (P99 1.98; cut for the bones 0.10). A shape too large is not judged: cut for the
+  // bones, a T-shirt on a 2.2 m body did better at BMI 15 and worse at BMI 45 (docs/garments.md,
+  // "A shape too small for the person").
+  static constexpr float kTrackedBoneScale = 0.85f;  // the shared Kinect and CMU takes on the default body: 0.82-0.94
   static constexpr float kShapeMisfit = 1.25f;
   bool shapeFitsPerson(const std::array<float, kBoneCount>& bones) const;
   bool shapeFitsPerson() const { return shapeFits_; }
