@@ -373,6 +373,22 @@ uint8_t cutOf(drape_garment* g) {
   return s.cut;
 }
 
+// A small square of cloth in Drape's own frame and metres, in front of the chest: a caller's mesh
+// (drape_context_add_garment_mesh) with desc `d` (null: the defaults). Null on failure.
+drape_garment* addChestPatch(drape_context* ctx, const drape_garment_desc* d) {
+  const drape_vec3 quad[4] = {{-0.1f, 1.1f, 2.3f}, {0.1f, 1.1f, 2.3f}, {0.1f, 1.3f, 2.3f}, {-0.1f, 1.3f, 2.3f}};
+  const uint32_t tris[6] = {0, 1, 2, 0, 2, 3};
+  drape_mesh_fit fit;
+  EXPECT_EQ(drape_mesh_fit_init(&fit), DRAPE_OK);
+  fit.unit_scale = 1.0f;
+  fit.facing = 1;
+  fit.source_floor_y_m = 0.0f;
+  fit.source_axis_z_m = 2.5f;
+  drape_garment* patch = nullptr;
+  EXPECT_EQ(drape_context_add_garment_mesh(ctx, quad, 4, tris, 6, &fit, d, nullptr, &patch), DRAPE_OK) << lastError();
+  return patch;
+}
+
 float extentY(const std::vector<drape_vec3>& v) {
   float lo = 1e30f, hi = -1e30f;
   for (const drape_vec3& p : v) {
@@ -449,17 +465,8 @@ TEST(CApiGarments, ByKindCutsTrousersAndLongSleevesForTheSkeleton) {
     EXPECT_EQ(cutOf(garments.back()), c.cut) << "kind " << c.kind;
   }
   // A caller's mesh has no kind: it follows the context.
-  // (In front of the chest, as CallerMeshAndObjGarments places it.)
-  const drape_vec3 quad[4] = {{-0.1f, 1.1f, 2.3f}, {0.1f, 1.1f, 2.3f}, {0.1f, 1.3f, 2.3f}, {-0.1f, 1.3f, 2.3f}};
-  const uint32_t tris[6] = {0, 1, 2, 0, 2, 3};
-  drape_mesh_fit fit;
-  ASSERT_OK(drape_mesh_fit_init(&fit));
-  fit.unit_scale = 1.0f;
-  fit.facing = 1;
-  fit.source_floor_y_m = 0.0f;
-  fit.source_axis_z_m = 2.5f;
-  drape_garment* patch = nullptr;
-  ASSERT_OK(drape_context_add_garment_mesh(ctx.get(), quad, 4, tris, 6, &fit, &d, nullptr, &patch));
+  drape_garment* patch = addChestPatch(ctx.get(), &d);
+  ASSERT_NE(patch, nullptr);
   EXPECT_EQ(cutOf(patch), DRAPE_GARMENT_FIT_SHAPE);
   // The first pose, every limb joint tracked: the trousers and the long sleeves are cut for its
   // bones before their first step (the provisional fit); the calibration finds the same bones in
@@ -499,16 +506,8 @@ TEST(CApiGarments, ByKindCutsForTheSkeletonWhenTheShapeIsTooSmallForThePerson) {
   drape_garment* legs = addTemplateCut(ctx.get(), DRAPE_GARMENT_TROUSERS, DRAPE_GARMENT_CUT_BY_KIND);
   drape_garment* kept = addTemplateCut(ctx.get(), DRAPE_GARMENT_TSHIRT, DRAPE_GARMENT_CUT_SHAPE);
   ASSERT_TRUE(top && dress && legs && kept);
-  const drape_vec3 quad[4] = {{-0.1f, 1.1f, 2.3f}, {0.1f, 1.1f, 2.3f}, {0.1f, 1.3f, 2.3f}, {-0.1f, 1.3f, 2.3f}};
-  const uint32_t tris[6] = {0, 1, 2, 0, 2, 3};
-  drape_mesh_fit fit;
-  ASSERT_OK(drape_mesh_fit_init(&fit));
-  fit.unit_scale = 1.0f;
-  fit.facing = 1;
-  fit.source_floor_y_m = 0.0f;
-  fit.source_axis_z_m = 2.5f;
-  drape_garment* patch = nullptr;
-  ASSERT_OK(drape_context_add_garment_mesh(ctx.get(), quad, 4, tris, 6, &fit, nullptr, nullptr, &patch));
+  drape_garment* patch = addChestPatch(ctx.get(), nullptr);
+  ASSERT_NE(patch, nullptr);
   EXPECT_EQ(cutOf(top), DRAPE_GARMENT_FIT_SHAPE) << "no pose yet: nothing says the shape does not fit";
   EXPECT_EQ(cutOf(dress), DRAPE_GARMENT_FIT_SHAPE);
   const std::vector<drape_vec3> dressRest = restOf(dress);
@@ -556,17 +555,8 @@ TEST(CApiGarments, ByKindCutsForTheSkeletonWhenTheShapeIsTooSmallForThePerson) {
 
 TEST(CApiGarments, CallerMeshAndObjGarments) {
   ContextPtr ctx = makeContext();
-  // A small square of cloth in Drape's own frame and metres, in front of the chest.
-  const drape_vec3 quad[4] = {{-0.1f, 1.1f, 2.3f}, {0.1f, 1.1f, 2.3f}, {0.1f, 1.3f, 2.3f}, {-0.1f, 1.3f, 2.3f}};
-  const uint32_t tris[6] = {0, 1, 2, 0, 2, 3};
-  drape_mesh_fit fit;
-  drape_mesh_fit_init(&fit);
-  fit.unit_scale = 1.0f;
-  fit.facing = 1;
-  fit.source_floor_y_m = 0.0f;
-  fit.source_axis_z_m = 2.5f;
-  drape_garment* patch = nullptr;
-  ASSERT_OK(drape_context_add_garment_mesh(ctx.get(), quad, 4, tris, 6, &fit, nullptr, nullptr, &patch));
+  drape_garment* patch = addChestPatch(ctx.get(), nullptr);
+  ASSERT_NE(patch, nullptr);
   uint32_t nv = 0;
   ASSERT_OK(drape_garment_get_mesh_size(patch, &nv, nullptr));
   EXPECT_EQ(nv, 4u);
