@@ -250,6 +250,30 @@ TEST(StressBones, TrousersComeBackAfterReversedThighs) {
   expectRecovered(s, control, end, "trousers, reversed thighs");
 }
 
+// A dress under the forearms reversed for a second: the tracker calls the flip and the flip back
+// pose jumps, the dress is placed on the flipped pose meanwhile, then put back from before the flip.
+// That placement restarted where the shoulders sat (cloth/shoulder_seams.h), and the restore did
+// not bring it back: measured again from the restore on, the seam pins lifted an armhole off its arm
+// 20-50 frames later (an opening off in 13 frames of the recovery window; undisturbed 0). The kept
+// state holds the shoulders too since 2026-11-29's thirteenth session (docs/robustness.md).
+TEST(StressBones, DressComesBackAfterReversedForearms) {
+  STRESS_REQUIRE_TAKE(take, kComeHere);
+  const double end = kStart + 1.0;
+  const std::vector<double> times = fixedTimes(replayedSeconds(take, end + 2.0), 1.0 / 30.0);
+  Dressing dress;
+  dress.kind = DRAPE_GARMENT_DRESS;
+  const Series control = replay(take, times, nullptr, dress);
+  const Series s = replay(take, times, [&](double t, Joints& j) {
+    if (t < kStart || t >= end) return;
+    for (auto [elbow, wrist] : {std::pair{ElbowL, WristL}, std::pair{ElbowR, WristR}})
+      j[wrist].position = drape_vec3{2 * j[elbow].position.x - j[wrist].position.x, 2 * j[elbow].position.y - j[wrist].position.y,
+                                     2 * j[elbow].position.z - j[wrist].position.z};
+  }, dress);
+  print("dress, reversed forearms", s);
+  expectHealthy(s, "dress, reversed forearms");
+  expectRecovered(s, control, end, "dress, reversed forearms");
+}
+
 // ---------------------------------------------------------------------------------------------
 // NaN / Inf / 1e30 joints: refused with an error, the state bit-identical to a context that never
 // saw them. The same for refused steps, parameters and body shapes.

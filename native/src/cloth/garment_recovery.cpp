@@ -59,6 +59,7 @@ void GarmentSim::keepState(KeptState& k, const std::vector<Ellipsoid>& ellipsoid
   for (size_t i = 0; i < pins.size(); ++i) k.pins[i] = to_local * (pins[i] - pelvis.centre);
   k.ellipsoids.resize(ellipsoids.size());
   for (size_t i = 0; i < ellipsoids.size(); ++i) k.ellipsoids[i] = toFrame(ellipsoids[i], to_local, pelvis.centre);
+  k.shoulders = shoulders_;
   k.time_s = sim_time_s_;
   k.valid = true;
 }
@@ -90,6 +91,10 @@ bool GarmentSim::restoreState(KeptState& k, const BodyModel& body, const RingPos
   std::string err;
   if (!solver_->reset(scratch3_, err)) return false;
   k.valid = false;
+  // The shoulders' place comes back with the state: a placement during the glitch restarted it,
+  // and measured again on the glitch's or the restore's frames it lifted a dress's armhole off its
+  // arm a second later (docs/robustness.md, "The same scenarios on the other garments").
+  shoulders_ = k.shoulders;
 
   // Sweep from the kept pose to this one. The reachable set of ellipsoids may have changed since
   // (proxy culling): then the kept ellipsoids do not pair with the current ones and the garment

@@ -354,6 +354,7 @@ class GarmentSim {
   struct KeptState {
     std::vector<Vec3> x, pins;          // positions and attachment targets, pelvis ring frame
     std::vector<Ellipsoid> ellipsoids;  // the garment's ellipsoids then, pelvis ring frame
+    ShoulderSeams shoulders;            // where the shoulders sat then (a placement restarts it)
     double time_s = 0.0;                // sim_time_s_ when kept
     bool valid = false;
   };
