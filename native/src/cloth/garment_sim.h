@@ -348,9 +348,10 @@ class GarmentSim {
   // flips (or is swapped with another person's) for a moment, or a burst of sensor noise, leaves
   // the garment tangled or stretched well after the glitch ends: friction lets cloth caught on the
   // wrong side of a limb slide back only slowly. So the garment's state from before the glitch is
-  // kept relative to the pelvis ring (with its attachment targets and ellipsoids), and when the
-  // glitch ends with the attachments back within kRestoreMatchM of where they were, that state is
-  // restored and swept to the current pose by kCatchUpFrames frames of simulation.
+  // kept relative to the pelvis ring (with its attachment targets, its ellipsoids and where the
+  // shoulders sat), and when the glitch ends with the attachments back within kRestoreMatchM of
+  // where they were, that state is restored and swept to the current pose by kCatchUpFrames frames
+  // of simulation.
   struct KeptState {
     std::vector<Vec3> x, pins;          // positions and attachment targets, pelvis ring frame
     std::vector<Ellipsoid> ellipsoids;  // the garment's ellipsoids then, pelvis ring frame
