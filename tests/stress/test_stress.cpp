@@ -227,27 +227,35 @@ TEST(StressBones, ZeroLengthAndReversedBones) {
   }
 }
 
+// One garment of `kind` on Ges04 with the two bones (parent joint, child joint) reversed for one
+// second from kStart (the child reflected through the parent), against the undisturbed run: healthy,
+// and recovered one second after.
+void expectBackAfterReversedBones(int32_t kind, std::initializer_list<std::pair<int, int>> bones, const char* what) {
+  STRESS_REQUIRE_TAKE(take, kComeHere);
+  const double end = kStart + 1.0;
+  const std::vector<double> times = fixedTimes(replayedSeconds(take, end + 2.0), 1.0 / 30.0);
+  Dressing dressing;
+  dressing.kind = kind;
+  const Series control = replay(take, times, nullptr, dressing);
+  const Series s = replay(take, times, [&](double t, Joints& j) {
+    if (t < kStart || t >= end) return;
+    for (auto [parent, child] : bones)
+      j[child].position = drape_vec3{2 * j[parent].position.x - j[child].position.x,
+                                     2 * j[parent].position.y - j[child].position.y,
+                                     2 * j[parent].position.z - j[child].position.z};
+  }, dressing);
+  print(what, s);
+  expectHealthy(s, what);
+  expectRecovered(s, control, end, what);
+}
+
 // Trousers (cut by kind, for the skeleton once calibrated) under the thighs reversed for a second:
 // the thigh ellipsoids sweep through the torso and drag the trouser legs with them. Since the
 // tracker calls a tracked limb bone flipping in one frame a pose jump (skeleton/tracker.h), the
 // garment keeps its state before it and is put back when the thighs return; before, the legs stayed
 // tangled (P99 median 0.51 against 0.09 one second after, an opening off throughout).
 TEST(StressBones, TrousersComeBackAfterReversedThighs) {
-  STRESS_REQUIRE_TAKE(take, kComeHere);
-  const double end = kStart + 1.0;
-  const std::vector<double> times = fixedTimes(replayedSeconds(take, end + 2.0), 1.0 / 30.0);
-  Dressing trousers;
-  trousers.kind = DRAPE_GARMENT_TROUSERS;
-  const Series control = replay(take, times, nullptr, trousers);
-  const Series s = replay(take, times, [&](double t, Joints& j) {
-    if (t < kStart || t >= end) return;
-    for (auto [hip, knee] : {std::pair{HipL, KneeL}, std::pair{HipR, KneeR}})
-      j[knee].position = drape_vec3{2 * j[hip].position.x - j[knee].position.x, 2 * j[hip].position.y - j[knee].position.y,
-                                    2 * j[hip].position.z - j[knee].position.z};
-  }, trousers);
-  print("trousers, reversed thighs", s);
-  expectHealthy(s, "trousers, reversed thighs");
-  expectRecovered(s, control, end, "trousers, reversed thighs");
+  expectBackAfterReversedBones(DRAPE_GARMENT_TROUSERS, {{HipL, KneeL}, {HipR, KneeR}}, "trousers, reversed thighs");
 }
 
 // A dress under the forearms reversed for a second: the tracker calls the flip and the flip back
@@ -257,21 +265,7 @@ TEST(StressBones, TrousersComeBackAfterReversedThighs) {
 // 20-50 frames later (an opening off in 13 frames of the recovery window; undisturbed 0). The kept
 // state holds the shoulders too since 2026-11-29's thirteenth session (docs/robustness.md).
 TEST(StressBones, DressComesBackAfterReversedForearms) {
-  STRESS_REQUIRE_TAKE(take, kComeHere);
-  const double end = kStart + 1.0;
-  const std::vector<double> times = fixedTimes(replayedSeconds(take, end + 2.0), 1.0 / 30.0);
-  Dressing dress;
-  dress.kind = DRAPE_GARMENT_DRESS;
-  const Series control = replay(take, times, nullptr, dress);
-  const Series s = replay(take, times, [&](double t, Joints& j) {
-    if (t < kStart || t >= end) return;
-    for (auto [elbow, wrist] : {std::pair{ElbowL, WristL}, std::pair{ElbowR, WristR}})
-      j[wrist].position = drape_vec3{2 * j[elbow].position.x - j[wrist].position.x, 2 * j[elbow].position.y - j[wrist].position.y,
-                                     2 * j[elbow].position.z - j[wrist].position.z};
-  }, dress);
-  print("dress, reversed forearms", s);
-  expectHealthy(s, "dress, reversed forearms");
-  expectRecovered(s, control, end, "dress, reversed forearms");
+  expectBackAfterReversedBones(DRAPE_GARMENT_DRESS, {{ElbowL, WristL}, {ElbowR, WristR}}, "dress, reversed forearms");
 }
 
 // ---------------------------------------------------------------------------------------------
