@@ -263,7 +263,8 @@ namespace {
 // The summary's `fit` line: what the garment is cut for, and why.
 std::string fitText(const ReplayStats& s) {
   const bool skeleton = s.garment_fit == DRAPE_GARMENT_FIT_SKELETON;
-  std::string text = skeleton ? "the person's skeleton once calibrated" : "the body shape's standard proportions";
+  std::string text = skeleton ? "the person's skeleton (from the first frame, or once calibrated)"
+                              : "the body shape's standard proportions";
   const bool limbs = s.garment_kind == "trousers" || s.garment_kind == "longsleeve";
   if (s.garment_fit_by_kind && !skeleton) text += " (by its kind)";
   else if (s.garment_fit_by_kind) text += limbs ? " (by its kind: limbs to the wrists or ankles)" : " (by its kind: the body shape is too small for this person)";

@@ -221,7 +221,7 @@ void Context::fitGarmentsToSkeleton(bool provisional) {
   }
   for (Recut& r : now) {
     swapIn(*r.garment, std::move(*r.fresh));
-    if (GarmentCut* c = cutEntry(r.garment)) c->cut = r.cut;
+    if (GarmentCut* c = cutEntry(r.garment)) c->cut = kCutSkeleton;
   }
   // The adaptive pipeline's ellipsoid bounds come from the context's own cut's rest body.
   if (contextCut() == kCutSkeleton) proxyBounds_.clear();
@@ -267,7 +267,7 @@ void Context::advanceRecuts() {
     std::string unused;
     r.fresh->setParams(r.garment->params(), unused);  // the host's parameters of now (validated when set)
     swapIn(*r.garment, std::move(*r.fresh));
-    if (GarmentCut* c = cutEntry(r.garment)) c->cut = r.cut;
+    if (GarmentCut* c = cutEntry(r.garment)) c->cut = kCutSkeleton;
   }
   recuts_.clear();
   reachDirty_ = true;
@@ -414,14 +414,6 @@ drape_result Context::update(std::string& err) {
   // The torso over the calibration window, for the garments' cut (fitGarmentsToSkeleton).
   // Any garment may be cut for the skeleton (drape_garment_desc.cut), one added later too.
   if (newPose && !tracker_.calibrated()) torsoAverage_.add(pose);
-  if (newPose) {  // the provisional fit's count (fitGarmentsToSkeleton)
-    if (tracker_.calibrated()) {
-      uncalibratedPoses_ = 0;
-      provisionalFitDone_ = false;
-    } else {
-      ++uncalibratedPoses_;
-    }
-  }
   finishFrameCounters();
   skips_.updates = updates_;
   // A body that moved wakes the garments before anything is built for the frame.
@@ -584,9 +576,11 @@ drape_result Context::beginStep(float dt, std::string& err) {
   stepT0_ = Clock::now();
   // A recut dresses from the step after the calibration's, which makes the replacements.
   advanceRecuts();
-  if (tracker_.calibrated() && tracker_.calibrationCount() != fittedCalibration_) {
-    fitGarmentsToSkeleton(/*provisional=*/false);
-  } else if (!tracker_.calibrated() && !provisionalFitDone_ && uncalibratedPoses_ >= kProvisionalFitPoses) {
+  // (update() has given the tracker a pose by now: a step before any frame is refused.)
+  if (tracker_.calibrated()) {
+    provisionalFitDone_ = false;  // a tracker that starts calibrating again fits provisionally again
+    if (tracker_.calibrationCount() != fittedCalibration_) fitGarmentsToSkeleton(/*provisional=*/false);
+  } else if (!provisionalFitDone_) {
     provisionalFitDone_ = true;
     fitGarmentsToSkeleton(/*provisional=*/true);
   }

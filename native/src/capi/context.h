@@ -73,7 +73,6 @@ class Context {
   static constexpr float kTrackedBoneScale = 0.85f;  // the shared Kinect and CMU takes on the default body: 0.82-0.94
   static constexpr float kShapeMisfit = 1.25f;
   bool shapeFitsPerson(const std::array<float, kBoneCount>& bones) const;
-  bool shapeFitsPerson() const { return shapeFits_; }
   // The cut a garment of this context was made for (contextCut() for one that is not).
   RestCut cutOf(const GarmentSim& garment) const;
   RestCut contextCut() const {
@@ -158,8 +157,8 @@ class Context {
   TorsoAverage torsoAverage_;  // the torso over the calibration window
   uint32_t fittedCalibration_ = 0;  // the tracker's calibrationCount() last seen
   SkeletonPose garmentRestPose(RestCut cut) const;
-  // The skeleton's calibration (or, provisional, the bones of the first pose of a tracker that is
-  // calibrating): garments cut for the skeleton are cut again for these bones, and those cut for
+  // The skeleton's calibration (or, provisional, the bones of the first step's pose while the
+  // tracker is calibrating): garments cut for the skeleton are cut again for these bones, and those cut for
   // the shape while it fits are cut for the skeleton when it does not. The calibration cuts them
   // again for its own bones when those move the rest pose by kRefitBelowM or more. A provisional
   // fit acts on a shape that does not fit (garments cut for a body of another size would spend the
@@ -169,9 +168,7 @@ class Context {
   // for the first pose").
   void fitGarmentsToSkeleton(bool provisional);
   bool provisionalFitsFirstPose() const;
-  static constexpr int kProvisionalFitPoses = 1;
-  int uncalibratedPoses_ = 0;     // new poses since the tracker last started calibrating
-  bool provisionalFitDone_ = false;
+  bool provisionalFitDone_ = false;  // since the tracker last started calibrating
   bool shapeFits_ = true;         // shapeFitsPerson(bones) of the bones fitted last
   // A recut in progress (the skeleton's calibration): each garment cut for the skeleton has its
   // replacement, made on the new rest body, dressed kRecutFramesPerStep frames a step beside it
@@ -183,8 +180,7 @@ class Context {
   struct Recut {
     GarmentSim* garment = nullptr;
     std::unique_ptr<GarmentSim> fresh;
-    GarmentSim::Dressing dressing;
-    RestCut cut = kCutSkeleton;  // the garment's cut once swapped in
+    GarmentSim::Dressing dressing;  // the replacement is cut for the skeleton
   };
   std::vector<Recut> recuts_;
   BoneFit fitBeforeRecut_;
