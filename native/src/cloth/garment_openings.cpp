@@ -12,22 +12,35 @@ namespace {
 // Gauss linking integral of segments p1 -> p2 and p3 -> p4: the signed solid angle one subtends
 // seen along the other, over 4 pi (Klenin & Langowski 2000, eq. 15-16; exact for straight
 // segments). Computed in double: the arcsines of nearly parallel normals lose float precision.
+// Plain doubles in the order of the Eigen expressions this was first written with (3-vector sums
+// as x + (y + z), Eigen's unrolled reduction; cross products as Eigen's), so the same bits: the
+// opening count runs it for every loop edge against every body segment on every measured frame,
+// and in the sanitizer build (-O1) Eigen's expression templates stay calls there.
+struct D3 {
+  double x, y, z;
+};
+inline D3 d3(const Vec3& v) { return {static_cast<double>(v.x()), static_cast<double>(v.y()), static_cast<double>(v.z())}; }
+inline D3 operator-(const D3& a, const D3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline double dot(const D3& a, const D3& b) { return a.x * b.x + (a.y * b.y + a.z * b.z); }
+inline D3 cross(const D3& a, const D3& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+
 double segmentLinking(const Vec3& p1f, const Vec3& p2f, const Vec3& p3f, const Vec3& p4f) {
-  using V = Eigen::Vector3d;
-  const V p1 = p1f.cast<double>(), p2 = p2f.cast<double>(), p3 = p3f.cast<double>(), p4 = p4f.cast<double>();
-  const V r13 = p3 - p1, r14 = p4 - p1, r23 = p3 - p2, r24 = p4 - p2, r12 = p2 - p1, r34 = p4 - p3;
-  auto unit = [](const V& v, bool& ok) {
-    const double n = v.norm();
+  const D3 p1 = d3(p1f), p2 = d3(p2f), p3 = d3(p3f), p4 = d3(p4f);
+  const D3 r13 = p3 - p1, r14 = p4 - p1, r23 = p3 - p2, r24 = p4 - p2, r12 = p2 - p1, r34 = p4 - p3;
+  auto unit = [](const D3& v, bool& ok) {
+    const double n = std::sqrt(dot(v, v));
     ok = ok && n > 1e-15;
-    return ok ? V(v / n) : V::Zero();
+    return ok ? D3{v.x / n, v.y / n, v.z / n} : D3{0.0, 0.0, 0.0};
   };
   bool ok = true;
-  const V n1 = unit(r13.cross(r14), ok), n2 = unit(r14.cross(r24), ok), n3 = unit(r24.cross(r23), ok),
-          n4 = unit(r23.cross(r13), ok);
+  const D3 n1 = unit(cross(r13, r14), ok), n2 = unit(cross(r14, r24), ok), n3 = unit(cross(r24, r23), ok),
+           n4 = unit(cross(r23, r13), ok);
   if (!ok) return 0.0;  // touching or collinear segments: no solid angle
   auto asinc = [](double x) { return std::asin(std::clamp(x, -1.0, 1.0)); };
-  const double omega = asinc(n1.dot(n2)) + asinc(n2.dot(n3)) + asinc(n3.dot(n4)) + asinc(n4.dot(n1));
-  const double side = r34.cross(r12).dot(r13);
+  const double omega = asinc(dot(n1, n2)) + asinc(dot(n2, n3)) + asinc(dot(n3, n4)) + asinc(dot(n4, n1));
+  const double side = dot(cross(r34, r12), r13);
   return (side > 0.0 ? omega : side < 0.0 ? -omega : 0.0) / (4.0 * static_cast<double>(kPi));
 }
 

@@ -65,19 +65,30 @@ bool MassSpringSolver::setPinTargets(const Vec3* targets, size_t count, std::str
   return true;
 }
 
+// The per-spring and per-particle loops spell their arithmetic out in floats, in the order of the
+// Eigen expressions they replace (3-vector sums as x + (y + z), Eigen's unrolled reduction), so
+// the optimised build computes the same bits; unoptimised and sanitizer builds (-O1, where
+// Eigen's expression templates stay calls) run them several times faster.
 void MassSpringSolver::addSprings(const DistanceConstraints& c, float k) {
   if (k == 0.0f && params_.spring_damping == 0.0f) return;
   const float cd = params_.spring_damping;
   for (size_t s = 0; s < c.size(); ++s) {
     const uint32_t a = c.a[s], b = c.b[s];
-    const Vec3 d = x_[a].head<3>() - x_[b].head<3>();
-    const float len = d.norm();
+    const float* xa = x_[a].data();
+    const float* xb = x_[b].data();
+    const float dx = xa[0] - xb[0], dy = xa[1] - xb[1], dz = xa[2] - xb[2];
+    const float len = std::sqrt(dx * dx + (dy * dy + dz * dz));
     if (len <= 1e-9f) continue;
-    const Vec3 dir = d / len;
-    const float rel = (v_[a].head<3>() - v_[b].head<3>()).dot(dir);
-    const Vec3 force = (-k * (len - c.rest[s]) - cd * rel) * dir;
-    f_[a].head<3>() += force;
-    f_[b].head<3>() -= force;
+    const float ux = dx / len, uy = dy / len, uz = dz / len;
+    const float* va = v_[a].data();
+    const float* vb = v_[b].data();
+    const float rel = (va[0] - vb[0]) * ux + ((va[1] - vb[1]) * uy + (va[2] - vb[2]) * uz);
+    const float m = -k * (len - c.rest[s]) - cd * rel;
+    const float fx = m * ux, fy = m * uy, fz = m * uz;
+    float* fa = f_[a].data();
+    float* fb = f_[b].data();
+    fa[0] += fx, fa[1] += fy, fa[2] += fz;
+    fb[0] -= fx, fb[1] -= fy, fb[2] -= fz;
   }
 }
 
@@ -104,11 +115,15 @@ bool MassSpringSolver::step(float dt, int substeps) {
     // Symplectic Euler: v += h a, x += h v (every particle independent).
     for (size_t i = 0; i < n; ++i) prev_[i] = x_[i];
     for (size_t i = 0; i < n; ++i) {
-      const float w = x_[i].w();
+      float* x = x_[i].data();
+      const float w = x[3];
       if (w == 0.0f) continue;
-      const Vec3 v = (v_[i].head<3>() + h * (p.gravity + w * f_[i].head<3>())) * keep;
-      v_[i].head<3>() = v;
-      x_[i].head<3>() += h * v;
+      float* v = v_[i].data();
+      const float* f = f_[i].data();
+      for (int j = 0; j < 3; ++j) {
+        v[j] = (v[j] + h * (p.gravity[j] + w * f[j])) * keep;
+        x[j] += h * v[j];
+      }
     }
     const float t = s + 1 == substeps ? 1.0f : static_cast<float>(s + 1) * inv_n;
     for (size_t k = 0; k < pin_target_.size(); ++k) {

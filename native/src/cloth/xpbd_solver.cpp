@@ -58,14 +58,14 @@ void appendPadded(const DistanceConstraints& c, float compliance, uint32_t dummy
 
 #if DRAPE_XPBD_SSE
 // Loads particles i0..i3 (xyzw each) and transposes them to x, y, z, w across the four lanes.
-inline void gather4(const Vec4* x, const uint32_t* idx, __m128& px, __m128& py, __m128& pz,
+__attribute__((always_inline)) inline void gather4(const Vec4* x, const uint32_t* idx, __m128& px, __m128& py, __m128& pz,
                     __m128& pw) {
   __m128 r0 = _mm_load_ps(x[idx[0]].data()), r1 = _mm_load_ps(x[idx[1]].data());
   __m128 r2 = _mm_load_ps(x[idx[2]].data()), r3 = _mm_load_ps(x[idx[3]].data());
   _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
   px = r0; py = r1; pz = r2; pw = r3;
 }
-inline void scatter4(Vec4* x, const uint32_t* idx, __m128 px, __m128 py, __m128 pz, __m128 pw) {
+__attribute__((always_inline)) inline void scatter4(Vec4* x, const uint32_t* idx, __m128 px, __m128 py, __m128 pz, __m128 pw) {
   _MM_TRANSPOSE4_PS(px, py, pz, pw);
   _mm_store_ps(x[idx[0]].data(), px);
   _mm_store_ps(x[idx[1]].data(), py);
@@ -145,14 +145,15 @@ void projectBatches(Vec4* x, const uint32_t* A, const uint32_t* B, const float* 
 // the 4x4 transposes run in-lane (AVX1 shuffles) and cost the same as for 4 constraints.
 // Particles are addressed by byte offsets (index * 16, Batches::a_off): an index would need a
 // shift before every one of the 32 loads and stores of a batch (x86 scales addresses by at most 8),
-// a sixth of the kernel's instructions.
+// a sixth of the kernel's instructions. The helpers are always_inline: -O3 inlines them anyway,
+// the sanitizer build (-O1) called them: 9 % of GarmentOnCloseRange's time there (perf).
 __attribute__((target("avx"), always_inline)) inline float* at(Vec4* x, uint32_t off) {
   return reinterpret_cast<float*>(reinterpret_cast<char*>(x) + off);
 }
-__attribute__((target("avx"))) inline __m256 pair8(Vec4* x, const uint32_t* off, int i) {
+__attribute__((target("avx"), always_inline)) inline __m256 pair8(Vec4* x, const uint32_t* off, int i) {
   return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(at(x, off[i]))), _mm_load_ps(at(x, off[i + 4])), 1);
 }
-__attribute__((target("avx"))) inline void gather8(Vec4* x, const uint32_t* off, __m256& px,
+__attribute__((target("avx"), always_inline)) inline void gather8(Vec4* x, const uint32_t* off, __m256& px,
                                                    __m256& py, __m256& pz, __m256& pw) {
   const __m256 r0 = pair8(x, off, 0), r1 = pair8(x, off, 1), r2 = pair8(x, off, 2),
                r3 = pair8(x, off, 3);
@@ -163,7 +164,7 @@ __attribute__((target("avx"))) inline void gather8(Vec4* x, const uint32_t* off,
   pz = _mm256_shuffle_ps(t1, t3, 0x44);
   pw = _mm256_shuffle_ps(t1, t3, 0xEE);
 }
-__attribute__((target("avx"))) inline void scatter8(Vec4* x, const uint32_t* off, __m256 px,
+__attribute__((target("avx"), always_inline)) inline void scatter8(Vec4* x, const uint32_t* off, __m256 px,
                                                     __m256 py, __m256 pz, __m256 pw) {
   const __m256 t0 = _mm256_unpacklo_ps(px, py), t1 = _mm256_unpackhi_ps(px, py);
   const __m256 t2 = _mm256_unpacklo_ps(pz, pw), t3 = _mm256_unpackhi_ps(pz, pw);

@@ -51,10 +51,22 @@ inline bool overlaps(const Vec3& lo, const Vec3& hi, const Vec3& mn, const Vec3&
 
 // Cell coordinates of a point (4-wide: the w lane is ignored), clamped to the grid. Monotone in
 // each coordinate, so a point inside two boxes lies in a cell both boxes' cell ranges include.
+// SSE spelled out as Eigen's packet code has it (max(x, 0) as _mm_max_ps(0, x), min(x, top) as
+// _mm_min_ps(top, x), truncating cast): the same bits, and no calls into Eigen's expression
+// templates in the sanitizer build (-O1), where they were 8 % of GarmentOnCloseRange's time (perf).
 inline Eigen::Array4i cellsOf(const Vec3& p, const Eigen::Array4f& origin, const Eigen::Array4f& scale,
                               const Eigen::Array4f& top) {
+#if defined(__SSE2__) || defined(_M_X64)
+  const __m128 v = _mm_setr_ps(p.x(), p.y(), p.z(), 0.0f);
+  const __m128 scaled = _mm_mul_ps(_mm_sub_ps(v, _mm_loadu_ps(origin.data())), _mm_loadu_ps(scale.data()));
+  const __m128 clamped = _mm_min_ps(_mm_loadu_ps(top.data()), _mm_max_ps(_mm_setzero_ps(), scaled));
+  Eigen::Array4i out;
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(out.data()), _mm_cvttps_epi32(clamped));
+  return out;
+#else
   const Eigen::Array4f v(p.x(), p.y(), p.z(), 0.0f);
   return ((v - origin) * scale).max(Eigen::Array4f::Zero()).min(top).cast<int>();
+#endif
 }
 
 using Vec4 = Eigen::Vector4f;
