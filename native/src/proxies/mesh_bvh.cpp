@@ -37,12 +37,17 @@ Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const V
                             TriangleFeature* feature) {
   TriangleFeature f = TriangleFeature::Face;
   Vec3 result;
-  const Vec3 ab = b - a, ac = c - a, ap = p - a;
-  const float d1 = ab.dot(ap), d2 = ac.dot(ap);
-  const Vec3 bp = p - b;
-  const float d3 = ab.dot(bp), d4 = ac.dot(bp);
-  const Vec3 cp = p - c;
-  const float d5 = ab.dot(cp), d6 = ac.dot(cp);
+  const Vec3 ab = b - a, ac = c - a;
+  // The six dot products in plain floats, summed as Eigen's 3-vector dot (x + (y + z)): the same
+  // bits, and no calls into Eigen's expression templates in the sanitizer build (-O1), where every
+  // triangle a closest-point query visits paid for them.
+  const float apx = p.x() - a.x(), apy = p.y() - a.y(), apz = p.z() - a.z();
+  const float bpx = p.x() - b.x(), bpy = p.y() - b.y(), bpz = p.z() - b.z();
+  const float cpx = p.x() - c.x(), cpy = p.y() - c.y(), cpz = p.z() - c.z();
+  const float abx = ab.x(), aby = ab.y(), abz = ab.z(), acx = ac.x(), acy = ac.y(), acz = ac.z();
+  const float d1 = abx * apx + (aby * apy + abz * apz), d2 = acx * apx + (acy * apy + acz * apz);
+  const float d3 = abx * bpx + (aby * bpy + abz * bpz), d4 = acx * bpx + (acy * bpy + acz * bpz);
+  const float d5 = abx * cpx + (aby * cpy + abz * cpz), d6 = acx * cpx + (acy * cpy + acz * cpz);
   const float vc = d1 * d4 - d3 * d2;
   const float vb = d5 * d2 - d1 * d6;
   const float va = d3 * d6 - d5 * d4;
