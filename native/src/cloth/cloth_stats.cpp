@@ -15,7 +15,13 @@ StretchStats stretchStats(const GarmentTopology& topology, const Eigen::Vector4f
   double sum = 0.0;
   float mx = -1.0f;
   for (size_t k = 0; k < n; ++k) {
-    const float len = (positions[c.a[k]] - positions[c.b[k]]).head<3>().norm();
+    // Plain floats, the norm's sum as Eigen's x + (y + z): the same bits, and no calls into
+    // Eigen's expression templates in the sanitizer build (-O1), which measures every edge of
+    // every garment on every measured frame.
+    const float* pa = positions[c.a[k]].data();
+    const float* pb = positions[c.b[k]].data();
+    const float dx = pa[0] - pb[0], dy = pa[1] - pb[1], dz = pa[2] - pb[2];
+    const float len = std::sqrt(dx * dx + (dy * dy + dz * dz));
     const float r = c.rest[k] > 0.0f ? len / c.rest[k] - 1.0f : 0.0f;
     scratch[k] = r;
     mx = std::max(mx, r);

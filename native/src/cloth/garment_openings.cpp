@@ -1,5 +1,6 @@
 #include "cloth/garment_openings.h"
 #include "cloth/garment_topology.h"
+#include "common/plain3.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,25 +13,14 @@ namespace {
 // Gauss linking integral of segments p1 -> p2 and p3 -> p4: the signed solid angle one subtends
 // seen along the other, over 4 pi (Klenin & Langowski 2000, eq. 15-16; exact for straight
 // segments). Computed in double: the arcsines of nearly parallel normals lose float precision.
-// Plain doubles in the order of the Eigen expressions this was first written with (3-vector sums
-// as x + (y + z), Eigen's unrolled reduction; cross products as Eigen's), so the same bits: the
-// opening count runs it for every loop edge against every body segment on every measured frame,
-// and in the sanitizer build (-O1) Eigen's expression templates stay calls there.
-struct D3 {
-  double x, y, z;
-};
-inline D3 d3(const Vec3& v) { return {static_cast<double>(v.x()), static_cast<double>(v.y()), static_cast<double>(v.z())}; }
-inline D3 operator-(const D3& a, const D3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline double dot(const D3& a, const D3& b) { return a.x * b.x + (a.y * b.y + a.z * b.z); }
-inline D3 cross(const D3& a, const D3& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-
+// Plain doubles (common/plain3.h): the opening count runs this for every loop edge against every
+// body segment on every measured frame.
 double segmentLinking(const Vec3& p1f, const Vec3& p2f, const Vec3& p3f, const Vec3& p4f) {
-  const D3 p1 = d3(p1f), p2 = d3(p2f), p3 = d3(p3f), p4 = d3(p4f);
+  using D3 = Plain3<double>;
+  const D3 p1 = plain3<double>(p1f), p2 = plain3<double>(p2f), p3 = plain3<double>(p3f), p4 = plain3<double>(p4f);
   const D3 r13 = p3 - p1, r14 = p4 - p1, r23 = p3 - p2, r24 = p4 - p2, r12 = p2 - p1, r34 = p4 - p3;
   auto unit = [](const D3& v, bool& ok) {
-    const double n = std::sqrt(dot(v, v));
+    const double n = norm(v);
     ok = ok && n > 1e-15;
     return ok ? D3{v.x / n, v.y / n, v.z / n} : D3{0.0, 0.0, 0.0};
   };

@@ -1,6 +1,7 @@
 #include "proxies/mesh_bvh.h"
 
 #include "body/mesh_metrics.h"
+#include "common/plain3.h"
 
 #include <algorithm>
 #include <cmath>
@@ -214,7 +215,17 @@ bool TriangleBvh::refit(const std::vector<Vec3>& positions) {
   return true;
 }
 
+// Plain floats in the order of the Eigen expressions they replace (Eigen's cross product; sums of
+// three as x + (y + z)): the same bits, and no calls into Eigen's expression templates in the
+// sanitizer build (-O1), where refitting the body's tree for every measured frame was a fifth of
+// the stress scenarios' time there.
 void TriangleBvh::updateGeometry(const std::vector<Vec3>& positions) {
+  auto add = [](Vec3& to, float s, float x, float y, float z) {
+    float* t = to.data();
+    t[0] += s * x;
+    t[1] += s * y;
+    t[2] += s * z;
+  };
   for (Vec3& n : edge_normals_) n.setZero();
   for (Vec3& n : vertex_normals_) n.setZero();
   for (size_t s = 0; s < tris_.size(); ++s) {
@@ -223,28 +234,43 @@ void TriangleBvh::updateGeometry(const std::vector<Vec3>& positions) {
     corners_[3 * s] = a;
     corners_[3 * s + 1] = b;
     corners_[3 * s + 2] = c;
-    const Vec3 cr = (b - a).cross(c - a);
-    const float len = cr.norm();
+    const float abx = b.x() - a.x(), aby = b.y() - a.y(), abz = b.z() - a.z();
+    const float acx = c.x() - a.x(), acy = c.y() - a.y(), acz = c.z() - a.z();
+    const float crx = aby * acz - abz * acy, cry = abz * acx - abx * acz, crz = abx * acy - aby * acx;
+    const float len = std::sqrt(crx * crx + (cry * cry + crz * crz));
     if (!(len > 0.0f)) {
       face_normals_[s].setZero();
       continue;
     }
-    const Vec3 n = cr / len;
-    face_normals_[s] = n;
-    for (int k = 0; k < 3; ++k) edge_normals_[tri.e[k]] += n;
+    const float nx = crx / len, ny = cry / len, nz = crz / len;
+    face_normals_[s] = Vec3(nx, ny, nz);
+    for (int k = 0; k < 3; ++k) {
+      float* e = edge_normals_[tri.e[k]].data();
+      e[0] += nx;
+      e[1] += ny;
+      e[2] += nz;
+    }
     // Interior angles (|cross| is the same for all three corners); the third from the sum.
-    const float angle_a = std::atan2(len, (b - a).dot(c - a));
-    const float angle_b = std::atan2(len, (c - b).dot(a - b));
+    const float bcx = c.x() - b.x(), bcy = c.y() - b.y(), bcz = c.z() - b.z();
+    const float bax = a.x() - b.x(), bay = a.y() - b.y(), baz = a.z() - b.z();
+    const float angle_a = std::atan2(len, abx * acx + (aby * acy + abz * acz));
+    const float angle_b = std::atan2(len, bcx * bax + (bcy * bay + bcz * baz));
     const float angle_c = std::max(0.0f, kPi - angle_a - angle_b);
-    vertex_normals_[tri.v[0]] += angle_a * n;
-    vertex_normals_[tri.v[1]] += angle_b * n;
-    vertex_normals_[tri.v[2]] += angle_c * n;
+    add(vertex_normals_[tri.v[0]], angle_a, nx, ny, nz);
+    add(vertex_normals_[tri.v[1]], angle_b, nx, ny, nz);
+    add(vertex_normals_[tri.v[2]], angle_c, nx, ny, nz);
   }
   auto normalise = [](std::vector<Vec3>& v) {
     for (Vec3& n : v) {
-      const float len = n.norm();
-      if (len > 0.0f) n /= len;
-      else n.setZero();
+      float* x = n.data();
+      const float len = std::sqrt(x[0] * x[0] + (x[1] * x[1] + x[2] * x[2]));
+      if (len > 0.0f) {
+        x[0] /= len;
+        x[1] /= len;
+        x[2] /= len;
+      } else {
+        n.setZero();
+      }
     }
   };
   normalise(edge_normals_);
@@ -388,26 +414,30 @@ bool TriangleBvh::rayCrossings(const Vec3& p, const Eigen::Vector3d& d, int& cro
       stack[sp++] = self + 1;
       continue;
     }
+    // The triangle tests in plain doubles (common/plain3.h): every triangle of every visited leaf,
+    // for every vertex whose depth a measurement asks.
+    using D3 = Plain3<double>;
+    const D3 dd{d.x(), d.y(), d.z()}, oo{o.x(), o.y(), o.z()};
     for (uint32_t s = n.first; s < n.first + n.count; ++s) {
-      const Eigen::Vector3d a = corners_[3 * s].cast<double>();
-      const Eigen::Vector3d e1 = corners_[3 * s + 1].cast<double>() - a;
-      const Eigen::Vector3d e2 = corners_[3 * s + 2].cast<double>() - a;
-      const Eigen::Vector3d pv = d.cross(e2);
-      const double det = e1.dot(pv);
-      const double scale = e1.norm() * e2.norm();
+      const D3 a = plain3<double>(corners_[3 * s]);
+      const D3 e1 = plain3<double>(corners_[3 * s + 1]) - a;
+      const D3 e2 = plain3<double>(corners_[3 * s + 2]) - a;
+      const D3 pv = cross(dd, e2);
+      const double det = dot(e1, pv);
+      const double scale = norm(e1) * norm(e2);
       if (!(scale > 0.0)) continue;  // degenerate: bounds no volume
       if (std::fabs(det) < 1e-9 * scale) {
         // Along the plane: ambiguous only if the ray runs through the triangle's plane near p.
-        if (std::fabs((o - a).dot(e1.cross(e2))) < 1e-9 * scale) return false;
+        if (std::fabs(dot(oo - a, cross(e1, e2))) < 1e-9 * scale) return false;
         continue;
       }
-      const Eigen::Vector3d tv = o - a;
-      const double u = tv.dot(pv) / det;
+      const D3 tv = oo - a;
+      const double u = dot(tv, pv) / det;
       if (u < -kEdgeTol || u > 1.0 + kEdgeTol) continue;
-      const Eigen::Vector3d qv = tv.cross(e1);
-      const double v = d.dot(qv) / det;
+      const D3 qv = cross(tv, e1);
+      const double v = dot(dd, qv) / det;
       if (v < -kEdgeTol || u + v > 1.0 + kEdgeTol) continue;
-      const double t = e2.dot(qv) / det;
+      const double t = dot(e2, qv) / det;
       if (t <= 0.0) continue;  // behind p (p on the surface itself: its depth is ~0 either way)
       if (u < kEdgeTol || v < kEdgeTol || u + v > 1.0 - kEdgeTol) return false;
       // det = -d . (e1 x e2): negative where the ray leaves through the (outward) face.
