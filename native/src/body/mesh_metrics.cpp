@@ -1,4 +1,5 @@
 #include "body/mesh_metrics.h"
+#include "common/plain3.h"
 
 #include <algorithm>
 #include <cmath>
@@ -91,37 +92,23 @@ double windingNumber(const std::vector<Vec3>& positions, const std::vector<uint3
 
 void vertexNormals(const std::vector<Vec3>& positions, const std::vector<uint32_t>& indices,
                    std::vector<Vec3>& normals) {
-  // Plain floats in the order of the Eigen expressions they replace (Eigen's cross product; the
-  // norm's sum as x + (y + z)): the same bits, the OpenCL kernel's order (cl_normals.h), and no
-  // calls into Eigen's expression templates in the sanitizer build (-O1), where the body mesh's
-  // normals were half of a body-only test's time.
+  // Plain3 (common/plain3.h): the bits of the Eigen expressions it replaced, in the OpenCL
+  // kernel's order (cl_normals.h); the body mesh's normals were half of a body-only test's time in
+  // the sanitizer build as Eigen calls.
   std::fill(normals.begin(), normals.end(), Vec3::Zero());
   for (size_t t = 0; t + 2 < indices.size(); t += 3) {
     const uint32_t a = indices[t], b = indices[t + 1], c = indices[t + 2];
-    const Vec3& pa = positions[a];
-    const Vec3& pb = positions[b];
-    const Vec3& pc = positions[c];
-    const float ux = pb.x() - pa.x(), uy = pb.y() - pa.y(), uz = pb.z() - pa.z();
-    const float vx = pc.x() - pa.x(), vy = pc.y() - pa.y(), vz = pc.z() - pa.z();
+    const Plain3<float> pa = plain3<float>(positions[a]);
     // The cross product's length is twice the area: area weighting comes for free.
-    const float nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
-    for (uint32_t i : {a, b, c}) {
-      float* n = normals[i].data();
-      n[0] += nx;
-      n[1] += ny;
-      n[2] += nz;
-    }
+    const Plain3<float> n = cross(plain3<float>(positions[b]) - pa, plain3<float>(positions[c]) - pa);
+    addTo(normals[a], n);
+    addTo(normals[b], n);
+    addTo(normals[c], n);
   }
-  for (auto& v : normals) {
-    float* n = v.data();
-    const float len = std::sqrt(n[0] * n[0] + (n[1] * n[1] + n[2] * n[2]));
-    if (len > 1e-20f) {
-      n[0] /= len;
-      n[1] /= len;
-      n[2] /= len;
-    } else {
-      v = Vec3(0.0f, 1.0f, 0.0f);
-    }
+  for (Vec3& n : normals) {
+    const Plain3<float> v = plain3<float>(n);
+    const float len = norm(v);
+    n = len > 1e-20f ? toVec3(v / len) : Vec3(0.0f, 1.0f, 0.0f);
   }
 }
 

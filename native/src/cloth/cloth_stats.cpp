@@ -1,5 +1,7 @@
 #include "cloth/cloth_stats.h"
 
+#include "common/plain3.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -15,13 +17,9 @@ StretchStats stretchStats(const GarmentTopology& topology, const Eigen::Vector4f
   double sum = 0.0;
   float mx = -1.0f;
   for (size_t k = 0; k < n; ++k) {
-    // Plain floats, the norm's sum as Eigen's x + (y + z): the same bits, and no calls into
-    // Eigen's expression templates in the sanitizer build (-O1), which measures every edge of
-    // every garment on every measured frame.
-    const float* pa = positions[c.a[k]].data();
-    const float* pb = positions[c.b[k]].data();
-    const float dx = pa[0] - pb[0], dy = pa[1] - pb[1], dz = pa[2] - pb[2];
-    const float len = std::sqrt(dx * dx + (dy * dy + dz * dz));
+    // Plain3 (common/plain3.h): the same bits, and no Eigen calls in the sanitizer build, which
+    // measures every edge of every garment on every measured frame.
+    const float len = norm(plain3(positions[c.a[k]]) - plain3(positions[c.b[k]]));
     const float r = c.rest[k] > 0.0f ? len / c.rest[k] - 1.0f : 0.0f;
     scratch[k] = r;
     mx = std::max(mx, r);

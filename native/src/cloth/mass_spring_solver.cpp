@@ -1,5 +1,7 @@
 #include "cloth/mass_spring_solver.h"
 
+#include "common/plain3.h"
+
 #include <chrono>
 #include <cmath>
 #include <utility>
@@ -65,30 +67,22 @@ bool MassSpringSolver::setPinTargets(const Vec3* targets, size_t count, std::str
   return true;
 }
 
-// The per-spring and per-particle loops spell their arithmetic out in floats, in the order of the
-// Eigen expressions they replace (3-vector sums as x + (y + z), Eigen's unrolled reduction), so
-// the optimised build computes the same bits; unoptimised and sanitizer builds (-O1, where
-// Eigen's expression templates stay calls) run them several times faster.
+// The per-spring and per-particle loops in Plain3 / floats (common/plain3.h), in the order of the
+// Eigen expressions they replaced: the same bits in an optimised build; the sanitizer build (-O1),
+// where Eigen's expression templates stay calls, runs them several times faster.
 void MassSpringSolver::addSprings(const DistanceConstraints& c, float k) {
   if (k == 0.0f && params_.spring_damping == 0.0f) return;
   const float cd = params_.spring_damping;
   for (size_t s = 0; s < c.size(); ++s) {
     const uint32_t a = c.a[s], b = c.b[s];
-    const float* xa = x_[a].data();
-    const float* xb = x_[b].data();
-    const float dx = xa[0] - xb[0], dy = xa[1] - xb[1], dz = xa[2] - xb[2];
-    const float len = std::sqrt(dx * dx + (dy * dy + dz * dz));
+    const Plain3<float> d = plain3(x_[a]) - plain3(x_[b]);
+    const float len = norm(d);
     if (len <= 1e-9f) continue;
-    const float ux = dx / len, uy = dy / len, uz = dz / len;
-    const float* va = v_[a].data();
-    const float* vb = v_[b].data();
-    const float rel = (va[0] - vb[0]) * ux + ((va[1] - vb[1]) * uy + (va[2] - vb[2]) * uz);
-    const float m = -k * (len - c.rest[s]) - cd * rel;
-    const float fx = m * ux, fy = m * uy, fz = m * uz;
-    float* fa = f_[a].data();
-    float* fb = f_[b].data();
-    fa[0] += fx, fa[1] += fy, fa[2] += fz;
-    fb[0] -= fx, fb[1] -= fy, fb[2] -= fz;
+    const Plain3<float> dir = d / len;
+    const float rel = dot(plain3(v_[a]) - plain3(v_[b]), dir);
+    const Plain3<float> force = (-k * (len - c.rest[s]) - cd * rel) * dir;
+    addTo(f_[a], force);
+    subtractFrom(f_[b], force);
   }
 }
 

@@ -39,16 +39,13 @@ Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const V
   TriangleFeature f = TriangleFeature::Face;
   Vec3 result;
   const Vec3 ab = b - a, ac = c - a;
-  // The six dot products in plain floats, summed as Eigen's 3-vector dot (x + (y + z)): the same
-  // bits, and no calls into Eigen's expression templates in the sanitizer build (-O1), where every
-  // triangle a closest-point query visits paid for them.
-  const float apx = p.x() - a.x(), apy = p.y() - a.y(), apz = p.z() - a.z();
-  const float bpx = p.x() - b.x(), bpy = p.y() - b.y(), bpz = p.z() - b.z();
-  const float cpx = p.x() - c.x(), cpy = p.y() - c.y(), cpz = p.z() - c.z();
-  const float abx = ab.x(), aby = ab.y(), abz = ab.z(), acx = ac.x(), acy = ac.y(), acz = ac.z();
-  const float d1 = abx * apx + (aby * apy + abz * apz), d2 = acx * apx + (acy * apy + acz * apz);
-  const float d3 = abx * bpx + (aby * bpy + abz * bpz), d4 = acx * bpx + (acy * bpy + acz * bpz);
-  const float d5 = abx * cpx + (aby * cpy + abz * cpz), d6 = acx * cpx + (acy * cpy + acz * cpz);
+  // The six dot products in Plain3 (common/plain3.h): the same bits, and no Eigen calls in the
+  // sanitizer build for every triangle a closest-point query visits.
+  const Plain3<float> pab = plain3<float>(ab), pac = plain3<float>(ac), pp = plain3<float>(p);
+  const Plain3<float> ap = pp - plain3<float>(a), bp = pp - plain3<float>(b), cp = pp - plain3<float>(c);
+  const float d1 = dot(pab, ap), d2 = dot(pac, ap);
+  const float d3 = dot(pab, bp), d4 = dot(pac, bp);
+  const float d5 = dot(pab, cp), d6 = dot(pac, cp);
   const float vc = d1 * d4 - d3 * d2;
   const float vb = d5 * d2 - d1 * d6;
   const float va = d3 * d6 - d5 * d4;
@@ -215,17 +212,11 @@ bool TriangleBvh::refit(const std::vector<Vec3>& positions) {
   return true;
 }
 
-// Plain floats in the order of the Eigen expressions they replace (Eigen's cross product; sums of
-// three as x + (y + z)): the same bits, and no calls into Eigen's expression templates in the
-// sanitizer build (-O1), where refitting the body's tree for every measured frame was 18 % of three
-// stress scenarios' time (perf).
+// Plain3 (common/plain3.h): the bits of the Eigen expressions it replaced; refitting the body's
+// tree for every measured frame was 18 % of three stress scenarios' time in the sanitizer build as
+// Eigen calls (perf).
 void TriangleBvh::updateGeometry(const std::vector<Vec3>& positions) {
-  auto add = [](Vec3& to, float s, float x, float y, float z) {
-    float* t = to.data();
-    t[0] += s * x;
-    t[1] += s * y;
-    t[2] += s * z;
-  };
+  using P3 = Plain3<float>;
   for (Vec3& n : edge_normals_) n.setZero();
   for (Vec3& n : vertex_normals_) n.setZero();
   for (size_t s = 0; s < tris_.size(); ++s) {
@@ -234,43 +225,31 @@ void TriangleBvh::updateGeometry(const std::vector<Vec3>& positions) {
     corners_[3 * s] = a;
     corners_[3 * s + 1] = b;
     corners_[3 * s + 2] = c;
-    const float abx = b.x() - a.x(), aby = b.y() - a.y(), abz = b.z() - a.z();
-    const float acx = c.x() - a.x(), acy = c.y() - a.y(), acz = c.z() - a.z();
-    const float crx = aby * acz - abz * acy, cry = abz * acx - abx * acz, crz = abx * acy - aby * acx;
-    const float len = std::sqrt(crx * crx + (cry * cry + crz * crz));
+    const P3 pa = plain3<float>(a), pb = plain3<float>(b), pc = plain3<float>(c);
+    const P3 ab = pb - pa, ac = pc - pa;
+    const P3 cr = cross(ab, ac);
+    const float len = norm(cr);
     if (!(len > 0.0f)) {
       face_normals_[s].setZero();
       continue;
     }
-    const float nx = crx / len, ny = cry / len, nz = crz / len;
-    face_normals_[s] = Vec3(nx, ny, nz);
-    for (int k = 0; k < 3; ++k) {
-      float* e = edge_normals_[tri.e[k]].data();
-      e[0] += nx;
-      e[1] += ny;
-      e[2] += nz;
-    }
+    const P3 n = cr / len;
+    face_normals_[s] = toVec3(n);
+    for (int k = 0; k < 3; ++k) addTo(edge_normals_[tri.e[k]], n);
     // Interior angles (|cross| is the same for all three corners); the third from the sum.
-    const float bcx = c.x() - b.x(), bcy = c.y() - b.y(), bcz = c.z() - b.z();
-    const float bax = a.x() - b.x(), bay = a.y() - b.y(), baz = a.z() - b.z();
-    const float angle_a = std::atan2(len, abx * acx + (aby * acy + abz * acz));
-    const float angle_b = std::atan2(len, bcx * bax + (bcy * bay + bcz * baz));
+    const float angle_a = std::atan2(len, dot(ab, ac));
+    const float angle_b = std::atan2(len, dot(pc - pb, pa - pb));
     const float angle_c = std::max(0.0f, kPi - angle_a - angle_b);
-    add(vertex_normals_[tri.v[0]], angle_a, nx, ny, nz);
-    add(vertex_normals_[tri.v[1]], angle_b, nx, ny, nz);
-    add(vertex_normals_[tri.v[2]], angle_c, nx, ny, nz);
+    addTo(vertex_normals_[tri.v[0]], angle_a * n);
+    addTo(vertex_normals_[tri.v[1]], angle_b * n);
+    addTo(vertex_normals_[tri.v[2]], angle_c * n);
   }
   auto normalise = [](std::vector<Vec3>& v) {
     for (Vec3& n : v) {
-      float* x = n.data();
-      const float len = std::sqrt(x[0] * x[0] + (x[1] * x[1] + x[2] * x[2]));
-      if (len > 0.0f) {
-        x[0] /= len;
-        x[1] /= len;
-        x[2] /= len;
-      } else {
-        n.setZero();
-      }
+      const P3 p = plain3<float>(n);
+      const float len = norm(p);
+      if (len > 0.0f) n = toVec3(p / len);
+      else n.setZero();
     }
   };
   normalise(edge_normals_);
