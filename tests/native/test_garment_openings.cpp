@@ -77,6 +77,42 @@ TEST(GarmentOpeningsGeometry, LinkingOfALoopAndALine) {
   EXPECT_EQ(loopLinking(loop, {Vec3::Zero()}), 0.0f);
 }
 
+// A loop of n points in the plane of `ring` (its frame's first and third columns; the second is
+// the chain's direction), radius r round `centre`.
+std::vector<Vec3> loopInRingPlane(const RingPose& ring, const Vec3& centre, float r, int n = 48) {
+  std::vector<Vec3> loop;
+  for (int k = 0; k < n; ++k) {
+    const float a = 2.0f * kPi * static_cast<float>(k) / static_cast<float>(n);
+    loop.push_back(centre + r * (std::cos(a) * ring.frame.col(0) + std::sin(a) * ring.frame.col(2)));
+  }
+  return loop;
+}
+
+// The body parts run to the tips of the mesh (crown, fingertips, toes), not to the last ring's
+// centre: a cuff round the hand, the fingers through it, is on the arm. Ending at the hand joint,
+// as the arms did before, that cuff read 0.5, and a cuff at a CMU take's wrist (the hand joint 2 cm
+// past it) went off whenever the hand bent.
+TEST(GarmentOpeningsOnTheBody, BodyPartsRunToTheTipsSoACuffRoundTheHandIsOn) {
+  Context ctx(test::defaultDesc());
+  const BodyModel& body = ctx.restBody();
+  const std::vector<std::vector<Vec3>> parts = GarmentOpenings::bodyPolylines(body);
+  ASSERT_EQ(parts.size(), 5u);  // spine, arm L / R, leg L / R
+  EXPECT_EQ(parts[0].back(), body.apex(Chain::Head));
+  EXPECT_EQ(parts[1].back(), body.apex(Chain::ArmL));
+  EXPECT_EQ(parts[2].back(), body.apex(Chain::ArmR));
+  EXPECT_EQ(parts[3].back(), body.apex(Chain::LegL));
+  EXPECT_EQ(parts[4].back(), body.apex(Chain::LegR));
+
+  const RingPose& hand = body.rings()[static_cast<size_t>(body.chainFirstRing(Chain::ArmR) +
+                                                          body.chainRingCount(Chain::ArmR) - 1)];
+  const float r = std::max(hand.forward_m, hand.side_m) + 0.025f;
+  // Round the hand ring: the fingers (to the apex) go through it.
+  EXPECT_GE(std::fabs(loopLinking(loopInRingPlane(hand, hand.centre, r), parts[2])), GarmentOpenings::kBindLinking);
+  // Slid 2 cm past the fingertips: off.
+  const Vec3 past = body.apex(Chain::ArmR) + 0.02f * hand.frame.col(1);
+  EXPECT_LT(std::fabs(loopLinking(loopInRingPlane(hand, past, r), parts[2])), GarmentOpenings::kOffLinking);
+}
+
 struct OpeningsOfKind {
   GarmentKind kind;
   uint32_t openings;  // hem, collar and sleeves; waistband and legs; a skirt's hem and waistband

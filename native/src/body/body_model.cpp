@@ -339,6 +339,11 @@ void BodyModel::writeApexes(const SkeletonPose& pose) {
   positions_[apexFirst_ + 4] = pose.position[idx(Joint::FootR)] + endRing(Chain::LegR).frame.col(1) * (0.030f * H);
 }
 
+Vec3 BodyModel::apex(Chain c) const {
+  if (c == Chain::Torso) return rings_[static_cast<size_t>(chainFirst_[idx2(c)] + chainCount_[idx2(c)] - 1)].centre;
+  return positions_[static_cast<size_t>(apexFirst_ + idx2(c) - 1)];
+}
+
 void BodyModel::computeNormals() { vertexNormals(positions_, indices_, normals_); }
 
 void BodyModel::update(const SkeletonPose& pose) {

@@ -112,6 +112,9 @@ class BodyModel {
   int ringPoints() const { return K_; }
 
   const std::vector<Vec3>& positions() const { return positions_; }
+  // The tip of an open chain (Head, ArmL, ArmR, LegL, LegR): the mesh vertex beyond its last ring
+  // (crown, fingertips, toes), placed with the rings (updateRings). Torso: its last ring's centre.
+  Vec3 apex(Chain c) const;
   const std::vector<Vec3>& normals() const { return normals_; }
   const std::vector<uint32_t>& indices() const { return indices_; }
   // Triangles of the stitch between a shoulder's torso loop and its junction ring (for tests).

@@ -59,6 +59,7 @@ std::vector<std::vector<Vec3>> GarmentOpenings::bodyPolylines(const BodyModel& b
     if (down.norm() > 1e-6f) spine.insert(spine.begin(), spine[0] + down.normalized() * kSpineExtensionM);
   }
   centres(Chain::Head, spine);
+  spine.push_back(body.apex(Chain::Head));
   out.push_back(std::move(spine));
   for (Chain c : {Chain::ArmL, Chain::ArmR, Chain::LegL, Chain::LegR}) {
     std::vector<Vec3> limb;
@@ -69,6 +70,7 @@ std::vector<std::vector<Vec3>> GarmentOpenings::bodyPolylines(const BodyModel& b
       const Vec3 up = limb[0] - limb[1];
       if (up.norm() > 1e-6f) limb.insert(limb.begin(), limb[0] + up.normalized() * kLegExtensionM);
     }
+    limb.push_back(body.apex(c));
     out.push_back(std::move(limb));
   }
   return out;

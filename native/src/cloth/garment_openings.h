@@ -7,10 +7,12 @@
 // through the torso's and then the head's rings, and on below the pelvis ring (kSpineExtensionM,
 // away from the waist ring) so that a hem below the hips still goes round it; legs start inside
 // the pelvis (kLegExtensionM); arms start at the shoulder, not extended (a sleeve that slides off
-// the shoulder end is off). How much an opening goes round a polyline is their Gauss linking integral: +-1 for a loop
-// round a line that runs far on both sides, whatever the loop's shape (a crumpled trouser hem
-// round an ankle too), +-1/2 when the loop's centre is at the polyline's end, 0 for a loop beside
-// it. At bind time (the dressed garment on the rest body) every opening records the body part it
+// the shoulder end is off). Every part ends at its tip, the body mesh's apex beyond the last ring
+// (crown, fingertips, toes): a cuff round the wrist or the hand, the fingers through it, is on; one
+// past the fingertips is off. How much an opening goes round a polyline is their Gauss linking
+// integral: +-1 for a loop round a line that runs far on both sides, whatever the loop's shape (a
+// crumpled trouser hem round an ankle too), +-1/2 when the loop's centre is at the polyline's
+// end, 0 for a loop beside it. At bind time (the dressed garment on the rest body) every opening records the body part it
 // goes round most (|linking| >= kBindLinking; a T-shirt's hem goes round the spine and both legs,
 // the spine most); count() says how many openings are off theirs now: linking of the same sign
 // below kOffLinking, i.e. the loop has slid past the polyline's end or the body part has left it

@@ -378,12 +378,11 @@ void ProxyBuilder::buildAll(const BodyModel& body, const SkeletonPose& pose) {
     // slim ellipsoid from that ring to the apex covers it (section 0.45 of the ring, so it does
     // not bulge out of the cone by more than a few percent of the ring radius).
     const Chain ends[5] = {Chain::Head, Chain::ArmL, Chain::ArmR, Chain::LegL, Chain::LegR};
-    const auto& positions = body.positions();
     for (int a = 0; a < 5; ++a) {
       const int last = body.chainFirstRing(ends[a]) + body.chainRingCount(ends[a]) - 1;
       if (skipNext({ends[a], last, -1})) continue;
       const RingPose& r = rings[last];
-      const Vec3& apex = positions[positions.size() - 5 + static_cast<size_t>(a)];
+      const Vec3 apex = body.apex(ends[a]);
       const Vec3 span = apex - r.centre;
       const float len = span.norm();
       Ellipsoid e;
