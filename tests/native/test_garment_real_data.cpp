@@ -119,42 +119,86 @@ TEST(GarmentOnCloseRange, LowerBodyGarmentsComeThroughTheGuessedLegs) {
 // past the feet for the first second (the Kinect measures these people's legs 16 % shorter), and on
 // the shape's cut throughout they were off in every frame (docs/garments.md, "Cut by kind" and "Cut
 // for the first pose").
-class TrousersByKindOnRecording : public ::testing::TestWithParam<const char*> {};
+// A template cut as drape_garment_desc_init cuts it (DRAPE_GARMENT_CUT_BY_KIND: trousers and long
+// sleeves for the person's skeleton) and replayed over the first `max_frames` frames of a take,
+// every third frame measured for openings off their body part.
+struct ByKindRun {
+  int measured = 0, off = 0;
+  uint32_t refits_after_first = 0, refits = 0;
+};
 
-TEST_P(TrousersByKindOnRecording, StayOnTheLegsFromTheFirstFrame) {
-  DRAPE_REQUIRE_SHARED(path, GetParam());
+void replayByKind(const std::string& path, GarmentKind kind, uint32_t particles, size_t max_frames, ByKindRun& run) {
   Recording rec;
   std::string err;
   ASSERT_TRUE(readRecordingFile(path, 0, rec, err)) << err;
   Context ctx(test::defaultDesc());  // garment_fit: the shape's, as by default
-  const Context::RestCut cut = ctx.cutFor(DRAPE_GARMENT_CUT_BY_KIND, garmentReachesLimbEnds(GarmentKind::Trousers));
+  const Context::RestCut cut = ctx.cutFor(DRAPE_GARMENT_CUT_BY_KIND, garmentReachesLimbEnds(kind));
   ASSERT_EQ(cut, Context::kCutSkeleton);
   GarmentTemplateParams tp;
-  tp.kind = GarmentKind::Trousers;
-  tp.target_particles = 1000;
+  tp.kind = kind;
+  tp.target_particles = particles;
   auto made = GarmentSim::createTemplate(tp, TopologyParams{}, ClothSolverKind::Xpbd, GarmentSimParams{}, 0.5f,
                                          ctx.restBody(cut), ctx.restEllipsoids(cut), ctx.restEllipsoidGroups(cut), err);
   ASSERT_NE(made, nullptr) << err;
   GarmentSim* g = ctx.adoptGarment(std::move(made), cut);
-  int measured = 0, off = 0;
-  uint32_t refitsAfterFirst = 0;
   double prev = rec.frames[0].time_s - 1.0 / 30.0;
-  for (size_t f = 0; f < rec.frames.size(); ++f) {
+  for (size_t f = 0; f < rec.frames.size() && f < max_frames; ++f) {
     const RecordingFrame& fr = rec.frames[f];
     ASSERT_EQ(test::pushAndStep(ctx, rec, fr, fr.time_s, static_cast<float>(fr.time_s - prev), err), DRAPE_OK) << err;
     prev = fr.time_s;
-    if (f == 0) refitsAfterFirst = g->refits();
+    if (f == 0) run.refits_after_first = g->refits();
     if (f % 3 != 0) continue;
-    ++measured;
-    if (ctx.measureGarment(*g).openings.off > 0) ++off;
+    ++run.measured;
+    if (ctx.measureGarment(*g).openings.off > 0) ++run.off;
   }
-  std::printf("[ figures  ] %s: trousers off in %d of %d measured frames; cut again %u time(s) by the first step, %u in all\n",
-              GetParam(), off, measured, refitsAfterFirst, g->refits());
-  EXPECT_EQ(refitsAfterFirst, 1u) << "cut for the first pose before its first step";
-  EXPECT_LE(g->refits(), 2u) << "and at most once more, at the calibration";
-  EXPECT_GT(measured, 45);
-  EXPECT_EQ(off, 0) << "a trouser leg off its leg";
+  run.refits = g->refits();
 }
+
+// Trousers as drape_garment_desc_init cuts them (DRAPE_GARMENT_CUT_BY_KIND) on the Kinect takes:
+// cut for the person's legs from the first frame (the provisional fit of the first pose, whose
+// limbs the sensor sees: capi/context.h), then again at the calibration when its bones move the
+// rest pose by 1 cm or more; they are on the legs in every measured frame. Cut for the shape's
+// standard legs until the calibration (before 2026-11-29's thirteenth session), their hems hung
+// past the feet for the first second (the Kinect measures these people's legs 16 % shorter), and on
+// the shape's cut throughout they were off in every frame (docs/garments.md, "Cut by kind" and "Cut
+// for the first pose").
+class TrousersByKindOnRecording : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(TrousersByKindOnRecording, StayOnTheLegsFromTheFirstFrame) {
+  DRAPE_REQUIRE_SHARED(path, GetParam());
+  ByKindRun run;
+  ASSERT_NO_FATAL_FAILURE(replayByKind(path, GarmentKind::Trousers, 1000, SIZE_MAX, run));
+  std::printf("[ figures  ] %s: trousers off in %d of %d measured frames; cut again %u time(s) by the first step, %u in all\n",
+              GetParam(), run.off, run.measured, run.refits_after_first, run.refits);
+  EXPECT_EQ(run.refits_after_first, 1u) << "cut for the first pose before its first step";
+  EXPECT_LE(run.refits, 2u) << "and at most once more, at the calibration";
+  EXPECT_GT(run.measured, 45);
+  EXPECT_EQ(run.off, 0) << "a trouser leg off its leg";
+}
+
+// The long-sleeve on the CMU hop takes (airborne phases, arms flung; a stub of a hand 3.5 cm past
+// the wrist), 2 000 particles, the matrix's 300 frames: with its cuff at a tenth of the forearm
+// above the wrist (arm station 1.9, before 2026-11-29's fifteenth session) it rode onto the hand
+// and a sleeve was off in 41 and 33 of the 100 measured frames here; a quarter above (1.75) in 5
+// and 0 (docs/garments.md, "The long sleeve's cuff"). Release only (asan_slow: *131_0* instances).
+class LongSleeveByKindOnRecording : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(LongSleeveByKindOnRecording, KeepsItsSleevesOnAHoppingPerson) {
+  DRAPE_REQUIRE_SHARED(path, GetParam());
+  ByKindRun run;
+  ASSERT_NO_FATAL_FAILURE(replayByKind(path, GarmentKind::LongSleeve, 2000, 300, run));
+  std::printf("[ figures  ] %s: long-sleeve off in %d of %d measured frames\n", GetParam(), run.off, run.measured);
+  EXPECT_EQ(run.measured, 100);
+  EXPECT_LE(run.off, 10) << "a sleeve off its arm";
+}
+
+INSTANTIATE_TEST_SUITE_P(SharedData, LongSleeveByKindOnRecording,
+                         ::testing::Values("cmu_mocap_bvh/131_03.bvh", "cmu_mocap_bvh/scaled_131_03.bvh"),
+                         [](const ::testing::TestParamInfo<const char*>& info) {
+                           std::string name = info.param;
+                           name = name.substr(name.find('/') + 1);
+                           return name.substr(0, name.find('.'));
+                         });
 
 INSTANTIATE_TEST_SUITE_P(SharedData, TrousersByKindOnRecording,
                          ::testing::Values("kinect_v2_msft_labanotation/Ges01_wavehand.csv",
