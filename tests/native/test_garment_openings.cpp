@@ -90,8 +90,8 @@ std::vector<Vec3> loopInRingPlane(const RingPose& ring, const Vec3& centre, floa
 
 // The body parts run to the tips of the mesh (crown, fingertips, toes), not to the last ring's
 // centre: a cuff round the hand, the fingers through it, is on the arm. Ending at the hand joint,
-// as the arms did before, that cuff read 0.5, and a cuff at a CMU take's wrist (the hand joint 2 cm
-// past it) went off whenever the hand bent.
+// as the arms did before, that cuff read 0.5, and a cuff at a CMU take's wrist (the hand joint
+// 3.5 cm past it) went off whenever the hand bent.
 TEST(GarmentOpeningsOnTheBody, BodyPartsRunToTheTipsSoACuffRoundTheHandIsOn) {
   Context ctx(test::defaultDesc());
   const BodyModel& body = ctx.restBody();

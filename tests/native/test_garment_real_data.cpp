@@ -111,14 +111,6 @@ TEST(GarmentOnCloseRange, LowerBodyGarmentsComeThroughTheGuessedLegs) {
   }
 }
 
-// Trousers as drape_garment_desc_init cuts them (DRAPE_GARMENT_CUT_BY_KIND) on the Kinect takes:
-// cut for the person's legs from the first frame (the provisional fit of the first pose, whose
-// limbs the sensor sees: capi/context.h), then again at the calibration when its bones move the
-// rest pose by 1 cm or more; they are on the legs in every measured frame. Cut for the shape's
-// standard legs until the calibration (before 2026-11-29's thirteenth session), their hems hung
-// past the feet for the first second (the Kinect measures these people's legs 16 % shorter), and on
-// the shape's cut throughout they were off in every frame (docs/garments.md, "Cut by kind" and "Cut
-// for the first pose").
 // A template cut as drape_garment_desc_init cuts it (DRAPE_GARMENT_CUT_BY_KIND: trousers and long
 // sleeves for the person's skeleton) and replayed over the first `max_frames` frames of a take,
 // every third frame measured for openings off their body part.

@@ -12,12 +12,12 @@
 // past the fingertips is off. How much an opening goes round a polyline is their Gauss linking
 // integral: +-1 for a loop round a line that runs far on both sides, whatever the loop's shape (a
 // crumpled trouser hem round an ankle too), +-1/2 when the loop's centre is at the polyline's
-// end, 0 for a loop beside it. At bind time (the dressed garment on the rest body) every opening records the body part it
-// goes round most (|linking| >= kBindLinking; a T-shirt's hem goes round the spine and both legs,
-// the spine most); count() says how many openings are off theirs now: linking of the same sign
-// below kOffLinking, i.e. the loop has slid past the polyline's end or the body part has left it
-// through the cloth. Openings no polyline goes through at rest are not tracked (a cut that never
-// went round anything cannot come off it).
+// end, 0 for a loop beside it. At bind time (the dressed garment on the rest body) every opening
+// records the body part it goes round most (|linking| >= kBindLinking; a T-shirt's hem goes round
+// the spine and both legs, the spine most); count() says how many openings are off theirs now:
+// linking of the same sign below kOffLinking, i.e. the loop has slid past the polyline's end or
+// the body part has left it through the cloth. Openings no polyline goes through at rest are not
+// tracked (a cut that never went round anything cannot come off it).
 #pragma once
 
 #include "body/body_model.h"
