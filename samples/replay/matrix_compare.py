@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Compares two quality matrices written by matrix.sh (docs/replay.md, "Quality matrix").
 
-    matrix_compare.py BEFORE_DIR AFTER_DIR [--only SUBSTRING] [--by-garment] [--fail-if-different]
+    matrix_compare.py BEFORE_DIR AFTER_DIR [--only SUBSTRING] [--by-garment] [--by-take]
+                      [--fail-if-different]
 
 One row per run present in both (take_garment): pooled P99 stretch, frames with an opening off,
 the mean share of vertices deeper than 2 mm in the body, the worst measured frame's body
@@ -10,7 +11,9 @@ off-frame count is out of those); then, per figure, in how many runs it is
 lower / higher / equal, and the geometric mean of the ratios after / before (runs where both are
 positive). --by-garment adds the same geometric means per garment (a run named
 take_garment[_particles]) with the frames off summed before -> after: a change that helps one
-garment and costs another shows there, where the pooled means hide it. Exit status: 0; 1 with
+garment and costs another shows there, where the pooled means hide it. --by-take adds one line
+per take and garment with its resolutions pooled (frames off summed, mean stretch and worst
+frame): where on which take a change acts, over several draws. Exit status: 0; 1 with
 --fail-if-different when any figure of any run differs (a determinism check: the same tree twice
 must give the same numbers); 2 on bad input.
 """
@@ -62,6 +65,40 @@ def garment_of(run):
     if len(parts) >= 2 and parts[-1].isdigit():
         parts = parts[:-1]
     return parts[-1]
+
+
+def take_garment_of(run):
+    """take_garment of a run named take_garment or take_garment_particles (matrix.sh)."""
+    parts = run.split("_")
+    if len(parts) >= 2 and parts[-1].isdigit():
+        parts = parts[:-1]
+    return "_".join(parts)
+
+
+def by_take(names, before, after):
+    """One line per take x garment, its resolutions pooled: frames off summed, and the mean over
+    its runs of the pooled P99 stretch and of the worst frame's penetration P99, before -> after."""
+    read = dict((f[0], f[1]) for f in FIGURES)
+    groups = {}
+    for n in names:
+        groups.setdefault(take_garment_of(n), []).append(n)
+    width = max(len(g) for g in groups)
+    print()
+    print("per take and garment (resolutions pooled): runs, frames off summed, mean P99 stretch %, "
+          "mean worst P99 mm, before -> after")
+
+    def mean(label, runs, side):
+        values = [number(read[label], side[n][0]) for n in runs]
+        values = [v for v in values if v is not None]
+        return sum(values) / len(values) if values else float("nan")
+
+    for group in sorted(groups):
+        runs = groups[group]
+        off_b = sum(number(read["off frames"], before[n][0]) or 0 for n in runs)
+        off_a = sum(number(read["off frames"], after[n][0]) or 0 for n in runs)
+        print(f"  {group:{width}s} {len(runs):3d} runs  off {off_b:4.0f} -> {off_a:4.0f}"
+              f"  stretch {mean('P99 stretch %', runs, before):6.2f} -> {mean('P99 stretch %', runs, after):6.2f}"
+              f"  worst {mean('worst P99 mm', runs, before):5.1f} -> {mean('worst P99 mm', runs, after):5.1f}")
 
 
 def by_garment(names, before, after):
@@ -141,6 +178,8 @@ def main(argv):
         print(f"  {label:14s} {lower[k]:3d} / {higher[k]:3d} / {equal[k]:3d}   {geometric_mean(logs[k])}")
     if "--by-garment" in argv:
         by_garment(names, before, after)
+    if "--by-take" in argv:
+        by_take(names, before, after)
     if missing:
         print(f"in one folder only: {', '.join(missing)}")
     if "--fail-if-different" in argv and (differs or missing):
