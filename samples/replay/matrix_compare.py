@@ -61,10 +61,7 @@ def geometric_mean(logs):
 
 def garment_of(run):
     """The garment of a run named take_garment or take_garment_particles (matrix.sh)."""
-    parts = run.split("_")
-    if len(parts) >= 2 and parts[-1].isdigit():
-        parts = parts[:-1]
-    return parts[-1]
+    return take_garment_of(run).split("_")[-1]
 
 
 def take_garment_of(run):
