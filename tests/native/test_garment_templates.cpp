@@ -185,10 +185,10 @@ TEST_P(GarmentTemplate, SimulatesOneSecondSanely) {
   EXPECT_EQ(deep, 0) << "particles inside an ellipsoid by more than 1 mm";
   std::vector<float> scratch;
   const StretchStats st = stretchStats(solver.topology(), x, scratch);
-  // 10 % for every kind but the long-sleeve top, whose heavy-body 8 000-particle build stretches
+  // 10 % for every kind but the long-sleeve top, whose heavy-body 8 000-particle build stretched
   // 10.3 % at the armpit (sleeve squeezed between arm and torso ellipsoids): a known gap of the
-  // cloth issue, recorded in docs/cloth-solver.md. Its bound is the measured value rounded up,
-  // so any regression still fails.
+  // cloth issue, recorded in docs/cloth-solver.md. 7.5-8.1 % at 8 000 particles on 2026-11-29
+  // (2.6-3.3 % at 2 000); the bound was left at 11 %.
   const float bound = GetParam().kind == GarmentKind::LongSleeve ? 0.11f : 0.10f;
   EXPECT_LT(st.p99, bound) << "max " << st.max << " mean " << st.mean;
 }

@@ -798,13 +798,7 @@ GarmentAccuracy GarmentSim::measure(const std::vector<Ellipsoid>& ellipsoids, co
     for (size_t k = 0; k < ellipsoids.size(); ++k) {
       if (k < groups_.size() && !(groups_[k] & masks_[i])) continue;  // not one it collides with
       const Ellipsoid& e = ellipsoids[k];
-      // Coordinate by coordinate rather than as Eigen arrays: the same test, run for every particle
-      // against every ellipsoid on every measured frame, where the sanitizer build (-O1) leaves
-      // Eigen's array comparisons as calls.
-      const Vec3& lo = e.bounds_min;
-      const Vec3& hi = e.bounds_max;
-      if (p.x() < lo.x() || p.y() < lo.y() || p.z() < lo.z() || p.x() > hi.x() || p.y() > hi.y() || p.z() > hi.z())
-        continue;
+      if (!containsPoint(e.bounds_min, e.bounds_max, p)) continue;
       const Vec3 q = e.toUnit(p);
       const float r = q.norm();
       // Depth along the ray from the centre (an upper bound of the true depth): (1 - r) * |p - c| / r.

@@ -28,9 +28,9 @@ namespace {
 constexpr float kLongSleeveRootEaseM = 0.02f;
 // Where the long-sleeve's cuff sits, as an arm station (elbow 1, wrist 2): a quarter of the forearm
 // above the wrist. At 1.9 (a tenth) the cuff, cut to the body's ease and so about as wide as the
-// hand, rode onto the hand whenever the arm hung or swung; on a mocap skeleton's stub hand (CMU:
-// the hand joint 3.5 cm past the wrist) it was dragged over the hand's cap and off, and stretched
-// on the way. Over 56 runs (eight takes, seven resolutions) the frames with an opening off fell
+// hand, rode onto the hand whenever the arm hung or swung and stretched there; on a mocap
+// skeleton's stub hand (CMU: the hand joint 3.5 cm past the wrist) its loop then crossed the hand
+// and the sleeve counted off. Over 56 runs (eight takes, seven resolutions) the frames with an opening off fell
 // from 1 022 to 507 and the P99 stretch by 4 % (docs/garments.md, "The long sleeve's cuff").
 constexpr float kLongSleeveCuffU = 1.75f;
 

@@ -20,6 +20,17 @@ inline bool isFinite(const Vec3& v) {
   return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
 }
 
+// Whether p lies in the box [mn, mx] (bounds included; false for a NaN coordinate). The
+// comparisons are combined with & as integers rather than &&: no branch per comparison (random
+// particle data mispredicts), no compiler taking the & for a mistyped &&, and no Eigen array
+// calls in the sanitizer build (-O1), where this runs for every particle and ellipsoid.
+inline bool containsPoint(const Vec3& mn, const Vec3& mx, const Vec3& p) {
+  const unsigned inside = unsigned(p.x() >= mn.x()) & unsigned(p.x() <= mx.x()) &
+                          unsigned(p.y() >= mn.y()) & unsigned(p.y() <= mx.y()) &
+                          unsigned(p.z() >= mn.z()) & unsigned(p.z() <= mx.z());
+  return inside != 0u;
+}
+
 // A unit vector perpendicular to `n` (n need not be normalised but must be non-zero).
 inline Vec3 anyPerpendicular(const Vec3& n) {
   const Vec3 a = std::fabs(n.x()) < 0.9f * n.norm() ? Vec3::UnitX() : Vec3::UnitY();

@@ -1,5 +1,6 @@
 #include "proxies/collision.h"
 
+#include "common/plain3.h"
 #include "proxies/closest_point.h"
 #include "proxies/collision_internal.h"
 
@@ -158,7 +159,7 @@ void EllipsoidCollider::setEllipsoids(const Ellipsoid* start, const Ellipsoid* e
         f.from_unit(i, j) = e.rotation(i, j) * radii[j];
       }
       const float h0 = f.from_unit(i, 0), h1 = f.from_unit(i, 1), h2 = f.from_unit(i, 2);
-      const float half = std::sqrt(h0 * h0 + (h1 * h1 + h2 * h2));
+      const float half = norm(Plain3<float>{h0, h1, h2});
       mn[i] = e.centre[i] - half;
       mx[i] = e.centre[i] + half;
       const float row_sum = f.to_unit(i, 0) + (f.to_unit(i, 1) + f.to_unit(i, 2));

@@ -33,15 +33,7 @@ inline int lowestBit(uint64_t m) {
 #endif
 }
 
-// Box tests with & rather than &&: no branch per comparison (random particle data mispredicts).
-// The comparisons are combined as integers so that no compiler takes the & for a mistyped &&.
-inline bool containsPoint(const Vec3& mn, const Vec3& mx, const Vec3& p) {
-  const unsigned inside = unsigned(p.x() >= mn.x()) & unsigned(p.x() <= mx.x()) &
-                          unsigned(p.y() >= mn.y()) & unsigned(p.y() <= mx.y()) &
-                          unsigned(p.z() >= mn.z()) & unsigned(p.z() <= mx.z());
-  return inside != 0u;
-}
-
+// Box tests with & rather than && (containsPoint, common/math.h): no branch per comparison.
 inline bool overlaps(const Vec3& lo, const Vec3& hi, const Vec3& mn, const Vec3& mx) {
   const unsigned overlap = unsigned(lo.x() <= mx.x()) & unsigned(hi.x() >= mn.x()) &
                            unsigned(lo.y() <= mx.y()) & unsigned(hi.y() >= mn.y()) &
@@ -172,7 +164,7 @@ inline bool EllipsoidCollider::mayTouch(const Eigen::Vector4f* positions, const 
                                         size_t i, bool swept) const {
   if (!(positions[i].w() > 0.0f)) return false;
   const Vec3 x = positions[i].head<3>();
-  if (!collision_internal::containsPoint(grid_min_, grid_max_, x)) {
+  if (!containsPoint(grid_min_, grid_max_, x)) {
     if (!swept) return false;
     const Vec3 p0 = previous[i].head<3>();
     if (!collision_internal::overlaps(x.cwiseMin(p0), x.cwiseMax(p0), grid_min_, grid_max_)) return false;

@@ -20,13 +20,6 @@ float boxDistance(const Vec3& p, const Vec3& lo, const Vec3& hi) {
   return d.norm();
 }
 
-// Coordinate by coordinate, not as Eigen arrays: the same test, called for every sample against
-// every ellipsoid, where the sanitizer build (-O1) leaves Eigen's array comparisons as calls.
-bool inBox(const Vec3& p, const Vec3& lo, const Vec3& hi) {
-  return p.x() >= lo.x() && p.y() >= lo.y() && p.z() >= lo.z() && p.x() <= hi.x() && p.y() <= hi.y() &&
-         p.z() <= hi.z();
-}
-
 struct Stats {
   float mean = 0.0f, p95 = 0.0f, max = 0.0f, weighted_mean = 0.0f;
 };
@@ -121,7 +114,7 @@ FidelityReport measureFidelity(const std::vector<Vec3>& body_positions,
     const Vec3& p = samples[v];
     bool inside = false;
     for (size_t j = 0; j < m && !inside; ++j)
-      inside = inBox(p, ell[j].bounds_min, ell[j].bounds_max) && ell[j].implicit(p) < 0.0f;
+      inside = containsPoint(ell[j].bounds_min, ell[j].bounds_max, p) && ell[j].implicit(p) < 0.0f;
     float best = kInf;
     if (!inside) {
       // Nearest box first, so the remaining boxes prune against a good bound.
@@ -165,7 +158,7 @@ FidelityReport measureFidelity(const std::vector<Vec3>& body_positions,
       const Vec3 x = e.fromUnit(u);
       bool covered = false;
       for (size_t j = 0; j < m && !covered; ++j) {
-        if (j == i || !inBox(x, ell[j].bounds_min, ell[j].bounds_max)) continue;
+        if (j == i || !containsPoint(ell[j].bounds_min, ell[j].bounds_max, x)) continue;
         covered = ell[j].toUnit(x).norm() < 1.0f - kStrictlyInside;
       }
       if (covered) continue;
