@@ -172,7 +172,8 @@ TEST_P(TrousersByKindOnRecording, StayOnTheLegsFromTheFirstFrame) {
 // the wrist), 2 000 particles, the matrix's 300 frames: with its cuff at a tenth of the forearm
 // above the wrist (arm station 1.9, before 2026-11-29's fifteenth session) it rode onto the hand
 // and a sleeve was off in 41 and 33 of the 100 measured frames here; a quarter above (1.75) in 5
-// and 0 (docs/garments.md, "The long sleeve's cuff"). Release only (asan_slow: *131_0* instances).
+// and 0 (docs/garments.md, "The long sleeve's cuff"), and 0 and 0 with the closer cuff below.
+// Release only (asan_slow: *131_0* instances).
 class LongSleeveByKindOnRecording : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(LongSleeveByKindOnRecording, KeepsItsSleevesOnAHoppingPerson) {
@@ -180,6 +181,20 @@ TEST_P(LongSleeveByKindOnRecording, KeepsItsSleevesOnAHoppingPerson) {
   ByKindRun run;
   ASSERT_NO_FATAL_FAILURE(replayByKind(path, GarmentKind::LongSleeve, 2000, 300, run));
   std::printf("[ figures  ] %s: long-sleeve off in %d of %d measured frames\n", GetParam(), run.off, run.measured);
+  EXPECT_EQ(run.measured, 100);
+  EXPECT_LE(run.off, 10) << "a sleeve off its arm";
+}
+
+// The same at 1 500 particles, where the cuff's 16 particles are 4-5 cm apart: cut to the full ease
+// (2.5 cm) the stub hand crossed the cuff's rim between two of them and the sleeve counted off
+// until the forearm found its way back; at 0.6 of the ease (kLongSleeveCuffEaseScale, docs/garments.md, "A closer cuff")
+// it stays on. Off in 39 and 41 of the 100 measured frames at the full ease, 1 and 0 now.
+TEST_P(LongSleeveByKindOnRecording, KeepsItsSleevesAtFifteenHundredParticles) {
+  DRAPE_REQUIRE_SHARED(path, GetParam());
+  ByKindRun run;
+  ASSERT_NO_FATAL_FAILURE(replayByKind(path, GarmentKind::LongSleeve, 1500, 300, run));
+  std::printf("[ figures  ] %s: long-sleeve (1 500 particles) off in %d of %d measured frames\n", GetParam(),
+              run.off, run.measured);
   EXPECT_EQ(run.measured, 100);
   EXPECT_LE(run.off, 10) << "a sleeve off its arm";
 }

@@ -33,6 +33,15 @@ constexpr float kLongSleeveRootEaseM = 0.02f;
 // and the sleeve counted off. Over 56 runs (eight takes, seven resolutions) the frames with an opening off fell
 // from 1 022 to 507 and the P99 stretch by 4 % (docs/garments.md, "The long sleeve's cuff").
 constexpr float kLongSleeveCuffU = 1.75f;
+// The long-sleeve's ease at the cuff, as a fraction of the garment's ease (the sleeve tapers to it
+// linearly from the root's): 0.6 of the default 2.5 cm is 1.5 cm. Cut to the full ease, on the CMU
+// hop takes at 1 500 particles (16 cuff particles, 4-5 cm apart) the stub hand crossed the cuff's
+// rim between two particles and the sleeve counted off until the forearm found its way back (42
+// of 100 measured frames on 131_03); a cuff of 32 particles did not stop it, a closer one did. Over 56 runs (eight takes, seven resolutions) the frames with an
+// opening off fell from 507 to 268; the price is a closer forearm that stretches more (P99
+// stretch 1.17 times; in the run looked at, the added edge-frames above it lie on the forearm and
+// cuff): docs/garments.md, "A closer cuff".
+constexpr float kLongSleeveCuffEaseScale = 0.6f;
 
 struct Sec {
   Vec3 c = Vec3::Zero();
@@ -195,14 +204,14 @@ class Builder {
     }
     switch (p_.kind) {
       case GarmentKind::TShirt:
-        upper(h, 0.05f * p_.length_scale + hipDrop_, false, 0.5f * p_.length_scale, 0.0f, m);
+        upper(h, 0.05f * p_.length_scale + hipDrop_, false, 0.5f * p_.length_scale, 0.0f, 1.0f, m);
         break;
       case GarmentKind::LongSleeve:
         upper(h, 0.05f * p_.length_scale + hipDrop_, false, std::min(2.0f, kLongSleeveCuffU * p_.length_scale),
-              kLongSleeveRootEaseM, m);
+              kLongSleeveRootEaseM, kLongSleeveCuffEaseScale, m);
         break;
       case GarmentKind::Dress:
-        upper(h, 0.9f * kneeDrop_ * p_.length_scale, true, 0.35f * p_.length_scale, 0.0f, m);
+        upper(h, 0.9f * kneeDrop_ * p_.length_scale, true, 0.35f * p_.length_scale, 0.0f, 1.0f, m);
         break;
       case GarmentKind::Skirt: skirt(h, m); break;
       case GarmentKind::Trousers: trousers(h, m); break;
@@ -455,9 +464,10 @@ class Builder {
   }
 
   // Torso tube (hem below the hip -> armpit ring T), yoke strips to the neck base ring N,
-  // sleeves to arm station `sleeveU`, `rootEase` looser than the ease at the armhole and the ease
-  // at the cuff, linearly in between. Pins: collar ring, shoulder-seam tops (and waist for dresses).
-  void upper(float h, float hemDrop, bool aline, float sleeveU, float rootEase, GarmentMesh& m) {
+  // sleeves to arm station `sleeveU`, `rootEase` looser than the ease at the armhole and
+  // `cuffEaseScale` times the ease at the cuff, linearly in between. Pins: collar ring,
+  // shoulder-seam tops (and waist for dresses).
+  void upper(float h, float hemDrop, bool aline, float sleeveU, float rootEase, float cuffEaseScale, GarmentMesh& m) {
     const float e = p_.ease_m;
     const int torsoN = body_.chainRingCount(Chain::Torso);
     const int ringT = body_.chainFirstRing(Chain::Torso) + torsoN - 1;
@@ -531,7 +541,10 @@ class Builder {
       // long-sleeve's stretch went up again (matrix gm 1.094: docs/garments.md, "A looser long sleeve").
       const Sec s0 = chainSec(body_, arm, 0.0f, e);
       const int Ka = count(roundTo(secPerimeter(s0) / h, 4, 8));
-      auto apath = [&](float v) { return chainSec(body_, arm, v * sleeveU, e + rootEase * (1.0f - v)); };
+      // The cuff's term is exactly 0 at a scale of 1 (T-shirt, dress): their cut as before, to the bit.
+      auto apath = [&](float v) {
+        return chainSec(body_, arm, v * sleeveU, e + rootEase * (1.0f - v) + (cuffEaseScale - 1.0f) * e * v);
+      };
       const std::vector<Loop> sleeve = tube(m, samplePath(apath, h, counter()), Ka);
       stitch(loop, sleeve.front(), m);
       // Shoulder-seam top: the sleeve's first-ring points highest along the torso's up axis.
