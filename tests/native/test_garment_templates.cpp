@@ -188,7 +188,7 @@ TEST_P(GarmentTemplate, SimulatesOneSecondSanely) {
   // 10 % for every kind but the long-sleeve top, whose heavy-body 8 000-particle build stretched
   // 10.3 % at the armpit (sleeve squeezed between arm and torso ellipsoids): a known gap of the
   // cloth issue, recorded in docs/cloth-solver.md. 7.5-8.1 % at 8 000 particles on 2026-11-29
-  // (2.6-3.3 % at 2 000); the bound was left at 11 %.
+  // (2.6-3.3 % at 2 000), 7.9-8.8 % (3.0-3.7 %) with the closer cuff; the bound was left at 11 %.
   const float bound = GetParam().kind == GarmentKind::LongSleeve ? 0.11f : 0.10f;
   EXPECT_LT(st.p99, bound) << "max " << st.max << " mean " << st.mean;
 }
