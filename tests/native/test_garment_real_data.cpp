@@ -187,8 +187,9 @@ TEST_P(LongSleeveByKindOnRecording, KeepsItsSleevesOnAHoppingPerson) {
 
 // The same at 1 500 particles, where the cuff's 16 particles are 4-5 cm apart: cut to the full ease
 // (2.5 cm) the stub hand crossed the cuff's rim between two of them and the sleeve counted off
-// until the forearm found its way back; at 0.6 of the ease (kLongSleeveCuffEaseScale, docs/garments.md, "A closer cuff")
-// it stays on. Off in 39 and 41 of the 100 measured frames at the full ease, 1 and 0 now.
+// until the linking came back; at 0.6 of the ease (kLongSleeveCuffEaseScale, docs/garments.md,
+// "A closer cuff") it stays on. Off in 39 and 41 of the 100 measured frames at the full ease, 1 and
+// 0 now.
 TEST_P(LongSleeveByKindOnRecording, KeepsItsSleevesAtFifteenHundredParticles) {
   DRAPE_REQUIRE_SHARED(path, GetParam());
   ByKindRun run;

@@ -556,7 +556,8 @@ namespace Drape
         public GarmentKind Kind;
         /// <summary>particles: target particle count, [200, 200000] (the result is within 15 %); default 2000.</summary>
         public uint Particles;
-        /// <summary>ease_m: clearance over the body, [0.002, 0.1]; default 0.025.</summary>
+        /// <summary>ease_m: clearance over the body, [0.002, 0.1]; default 0.025 (a long sleeve: 2 cm more at the
+        /// armhole, tapering to 0.6 of it at the cuff).</summary>
         public float EaseM;
         /// <summary>length_scale: hem / sleeve / leg lengths, [0.5, 1.5]; default 1.</summary>
         public float LengthScale;

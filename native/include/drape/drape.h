@@ -484,7 +484,8 @@ typedef struct drape_garment_template {
   uint32_t struct_size;  /* sizeof(drape_garment_template), set by drape_garment_template_init */
   int32_t kind;          /* drape_garment_kind; default DRAPE_GARMENT_TSHIRT */
   uint32_t particles;    /* target particle count, [200, 200000] (result within 15 %); 2000 */
-  float ease_m;          /* clearance over the body, [0.002, 0.1]; 0.025 */
+  float ease_m;          /* clearance over the body, [0.002, 0.1]; 0.025 (a long sleeve: 2 cm more
+                            at the armhole, tapering to 0.6 of it at the cuff) */
   float length_scale;    /* hem / sleeve / leg lengths, [0.5, 1.5]; 1 */
   uint32_t reserved;     /* must be 0 */
 } drape_garment_template;

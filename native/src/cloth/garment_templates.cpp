@@ -36,11 +36,11 @@ constexpr float kLongSleeveCuffU = 1.75f;
 // The long-sleeve's ease at the cuff, as a fraction of the garment's ease (the sleeve tapers to it
 // linearly from the root's): 0.6 of the default 2.5 cm is 1.5 cm. Cut to the full ease, on the CMU
 // hop takes at 1 500 particles (16 cuff particles, 4-5 cm apart) the stub hand crossed the cuff's
-// rim between two particles and the sleeve counted off until the forearm found its way back (42
-// of 100 measured frames on 131_03); a cuff of 32 particles did not stop it, a closer one did. Over 56 runs (eight takes, seven resolutions) the frames with an
-// opening off fell from 507 to 268; the price is a closer forearm that stretches more (P99
-// stretch 1.17 times; in the run looked at, the added edge-frames above it lie on the forearm and
-// cuff): docs/garments.md, "A closer cuff".
+// rim between two particles and the sleeve counted off until the linking came back (42 of 100
+// measured frames on 131_03); a cuff of 32 particles did not stop it, a closer one did. Over 56
+// runs (eight takes, seven resolutions) the frames with an opening off fell from 507 to 268; the
+// price is a closer forearm that stretches more (P99 stretch 1.17 times; in the run looked at,
+// the added edge-frames above it lie on the forearm and cuff): docs/garments.md, "A closer cuff".
 constexpr float kLongSleeveCuffEaseScale = 0.6f;
 
 struct Sec {
