@@ -30,6 +30,7 @@ FIGURES = [
     ("worst P99 mm", lambda g: g["body_penetration_mm"]["p99"], "{:6.1f}"),
     ("inside", lambda g: float(g["proxy_inside"]), "{:4.0f}"),
 ]
+READ = {label: read for label, read, _ in FIGURES}
 
 
 def load(directory):
@@ -72,37 +73,42 @@ def take_garment_of(run):
     return "_".join(parts)
 
 
+def grouped(names, key):
+    """The runs of `names` grouped by key(run), as {group: [runs]}."""
+    groups = {}
+    for n in names:
+        groups.setdefault(key(n), []).append(n)
+    return groups
+
+
+def off_frames(runs, side):
+    """Frames with an opening off, summed over `runs` of one side (before or after)."""
+    return sum(number(READ["off frames"], side[n][0]) or 0 for n in runs)
+
+
 def by_take(names, before, after):
     """One line per take x garment, its resolutions pooled: frames off summed, and the mean over
     its runs of the pooled P99 stretch and of the worst frame's penetration P99, before -> after."""
-    read = dict((f[0], f[1]) for f in FIGURES)
-    groups = {}
-    for n in names:
-        groups.setdefault(take_garment_of(n), []).append(n)
+    groups = grouped(names, take_garment_of)
     width = max(len(g) for g in groups)
     print()
     print("per take and garment (resolutions pooled): runs, frames off summed, mean P99 stretch %, "
           "mean worst P99 mm, before -> after")
 
     def mean(label, runs, side):
-        values = [number(read[label], side[n][0]) for n in runs]
+        values = [number(READ[label], side[n][0]) for n in runs]
         values = [v for v in values if v is not None]
         return sum(values) / len(values) if values else float("nan")
 
     for group in sorted(groups):
         runs = groups[group]
-        off_b = sum(number(read["off frames"], before[n][0]) or 0 for n in runs)
-        off_a = sum(number(read["off frames"], after[n][0]) or 0 for n in runs)
-        print(f"  {group:{width}s} {len(runs):3d} runs  off {off_b:4.0f} -> {off_a:4.0f}"
+        print(f"  {group:{width}s} {len(runs):3d} runs  off {off_frames(runs, before):4.0f} -> {off_frames(runs, after):4.0f}"
               f"  stretch {mean('P99 stretch %', runs, before):6.2f} -> {mean('P99 stretch %', runs, after):6.2f}"
               f"  worst {mean('worst P99 mm', runs, before):5.1f} -> {mean('worst P99 mm', runs, after):5.1f}")
 
 
 def by_garment(names, before, after):
-    off_read = dict((f[0], f[1]) for f in FIGURES)["off frames"]
-    groups = {}
-    for n in names:
-        groups.setdefault(garment_of(n), []).append(n)
+    groups = grouped(names, garment_of)
     print()
     print("per garment: runs, geometric mean of after / before per figure, frames off summed")
     for garment in sorted(groups):
@@ -117,9 +123,8 @@ def by_garment(names, before, after):
                 if a is not None and b is not None and a > 0 and b > 0:
                     logs.append(math.log(a / b))
             cells.append(f"{label} {geometric_mean(logs)}")
-        off_b = sum(number(off_read, before[n][0]) or 0 for n in runs)
-        off_a = sum(number(off_read, after[n][0]) or 0 for n in runs)
-        print(f"  {garment:12s} {len(runs):3d} runs  " + "  ".join(cells) + f"  off frames {off_b:.0f} -> {off_a:.0f}")
+        print(f"  {garment:12s} {len(runs):3d} runs  " + "  ".join(cells)
+              + f"  off frames {off_frames(runs, before):.0f} -> {off_frames(runs, after):.0f}")
 
 
 def main(argv):

@@ -78,12 +78,16 @@ TEST(GarmentOpeningsGeometry, LinkingOfALoopAndALine) {
 }
 
 // A loop of n points in the plane of `ring` (its frame's first and third columns; the second is
-// the chain's direction), radius r round `centre`.
+// the chain's direction), radius r round `centre`: the ring's own ellipse (ringPointAt) moved and
+// made round.
 std::vector<Vec3> loopInRingPlane(const RingPose& ring, const Vec3& centre, float r, int n = 48) {
+  RingPose round = ring;
+  round.centre = centre;
+  round.forward_m = round.side_m = r;
   std::vector<Vec3> loop;
   for (int k = 0; k < n; ++k) {
     const float a = 2.0f * kPi * static_cast<float>(k) / static_cast<float>(n);
-    loop.push_back(centre + r * (std::cos(a) * ring.frame.col(0) + std::sin(a) * ring.frame.col(2)));
+    loop.push_back(ringPointAt(round, std::cos(a), std::sin(a)));
   }
   return loop;
 }

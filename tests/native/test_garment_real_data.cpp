@@ -174,31 +174,29 @@ TEST_P(TrousersByKindOnRecording, StayOnTheLegsFromTheFirstFrame) {
 // and a sleeve was off in 41 and 33 of the 100 measured frames here; a quarter above (1.75) in 5
 // and 0 (docs/garments.md, "The long sleeve's cuff"), and 0 and 0 with the closer cuff below.
 // Release only (asan_slow: *131_0* instances).
-class LongSleeveByKindOnRecording : public ::testing::TestWithParam<const char*> {};
+class LongSleeveByKindOnRecording : public ::testing::TestWithParam<const char*> {
+ protected:
+  // The take's first 300 frames at `particles`: every one of its 100 measured frames is measured,
+  // at most 10 with a sleeve off its arm.
+  void expectSleevesOn(uint32_t particles) {
+    DRAPE_REQUIRE_SHARED(path, GetParam());
+    ByKindRun run;
+    ASSERT_NO_FATAL_FAILURE(replayByKind(path, GarmentKind::LongSleeve, particles, 300, run));
+    std::printf("[ figures  ] %s: long-sleeve (%u particles) off in %d of %d measured frames\n", GetParam(),
+                particles, run.off, run.measured);
+    EXPECT_EQ(run.measured, 100);
+    EXPECT_LE(run.off, 10) << "a sleeve off its arm";
+  }
+};
 
-TEST_P(LongSleeveByKindOnRecording, KeepsItsSleevesOnAHoppingPerson) {
-  DRAPE_REQUIRE_SHARED(path, GetParam());
-  ByKindRun run;
-  ASSERT_NO_FATAL_FAILURE(replayByKind(path, GarmentKind::LongSleeve, 2000, 300, run));
-  std::printf("[ figures  ] %s: long-sleeve off in %d of %d measured frames\n", GetParam(), run.off, run.measured);
-  EXPECT_EQ(run.measured, 100);
-  EXPECT_LE(run.off, 10) << "a sleeve off its arm";
-}
+TEST_P(LongSleeveByKindOnRecording, KeepsItsSleevesOnAHoppingPerson) { expectSleevesOn(2000); }
 
 // The same at 1 500 particles, where the cuff's 16 particles are 4-5 cm apart: cut to the full ease
 // (2.5 cm) the stub hand crossed the cuff's rim between two of them and the sleeve counted off
 // until the linking came back; at 0.6 of the ease (kLongSleeveCuffEaseScale, docs/garments.md,
 // "A closer cuff") it stays on. Off in 39 and 41 of the 100 measured frames at the full ease, 1 and
 // 0 now.
-TEST_P(LongSleeveByKindOnRecording, KeepsItsSleevesAtFifteenHundredParticles) {
-  DRAPE_REQUIRE_SHARED(path, GetParam());
-  ByKindRun run;
-  ASSERT_NO_FATAL_FAILURE(replayByKind(path, GarmentKind::LongSleeve, 1500, 300, run));
-  std::printf("[ figures  ] %s: long-sleeve (1 500 particles) off in %d of %d measured frames\n", GetParam(),
-              run.off, run.measured);
-  EXPECT_EQ(run.measured, 100);
-  EXPECT_LE(run.off, 10) << "a sleeve off its arm";
-}
+TEST_P(LongSleeveByKindOnRecording, KeepsItsSleevesAtFifteenHundredParticles) { expectSleevesOn(1500); }
 
 INSTANTIATE_TEST_SUITE_P(SharedData, LongSleeveByKindOnRecording,
                          ::testing::Values("cmu_mocap_bvh/131_03.bvh", "cmu_mocap_bvh/scaled_131_03.bvh"),

@@ -204,14 +204,15 @@ class Builder {
     }
     switch (p_.kind) {
       case GarmentKind::TShirt:
-        upper(h, 0.05f * p_.length_scale + hipDrop_, false, 0.5f * p_.length_scale, 0.0f, 1.0f, m);
+        upper(h, 0.05f * p_.length_scale + hipDrop_, false, Sleeve{0.5f * p_.length_scale}, m);
         break;
       case GarmentKind::LongSleeve:
-        upper(h, 0.05f * p_.length_scale + hipDrop_, false, std::min(2.0f, kLongSleeveCuffU * p_.length_scale),
-              kLongSleeveRootEaseM, kLongSleeveCuffEaseScale, m);
+        upper(h, 0.05f * p_.length_scale + hipDrop_, false,
+              Sleeve{std::min(2.0f, kLongSleeveCuffU * p_.length_scale), kLongSleeveRootEaseM, kLongSleeveCuffEaseScale},
+              m);
         break;
       case GarmentKind::Dress:
-        upper(h, 0.9f * kneeDrop_ * p_.length_scale, true, 0.35f * p_.length_scale, 0.0f, 1.0f, m);
+        upper(h, 0.9f * kneeDrop_ * p_.length_scale, true, Sleeve{0.35f * p_.length_scale}, m);
         break;
       case GarmentKind::Skirt: skirt(h, m); break;
       case GarmentKind::Trousers: trousers(h, m); break;
@@ -463,11 +464,17 @@ class Builder {
     return s;
   }
 
-  // Torso tube (hem below the hip -> armpit ring T), yoke strips to the neck base ring N,
-  // sleeves to arm station `sleeveU`, `rootEase` looser than the ease at the armhole and
-  // `cuffEaseScale` times the ease at the cuff, linearly in between. Pins: collar ring,
-  // shoulder-seam tops (and waist for dresses).
-  void upper(float h, float hemDrop, bool aline, float sleeveU, float rootEase, float cuffEaseScale, GarmentMesh& m) {
+  // An upper garment's sleeve: to arm station `u`, `root_ease_m` looser than the ease at the
+  // armhole and `cuff_ease_scale` times the ease at the cuff, linearly in between.
+  struct Sleeve {
+    float u;
+    float root_ease_m = 0.0f;
+    float cuff_ease_scale = 1.0f;
+  };
+
+  // Torso tube (hem below the hip -> armpit ring T), yoke strips to the neck base ring N, and
+  // the sleeves. Pins: collar ring, shoulder-seam tops (and waist for dresses).
+  void upper(float h, float hemDrop, bool aline, const Sleeve& sl, GarmentMesh& m) {
     const float e = p_.ease_m;
     const int torsoN = body_.chainRingCount(Chain::Torso);
     const int ringT = body_.chainFirstRing(Chain::Torso) + torsoN - 1;
@@ -537,13 +544,13 @@ class Builder {
       loop.insert(loop.end(), up.rbegin(), up.rend());
       for (int r = R - 1; r >= 1; --r) loop.push_back(rows[static_cast<size_t>(r)][static_cast<size_t>(wrap(from))]);
       const Chain arm = left ? Chain::ArmL : Chain::ArmR;
-      // Ring points from the perimeter at the plain ease: counted at the looser cut (rootEase), the
+      // Ring points from the perimeter at the plain ease: counted at the looser cut (root_ease_m), the
       // long-sleeve's stretch went up again (matrix gm 1.094: docs/garments.md, "A looser long sleeve").
       const Sec s0 = chainSec(body_, arm, 0.0f, e);
       const int Ka = count(roundTo(secPerimeter(s0) / h, 4, 8));
       // The cuff's term is exactly 0 at a scale of 1 (T-shirt, dress): their cut as before, to the bit.
       auto apath = [&](float v) {
-        return chainSec(body_, arm, v * sleeveU, e + rootEase * (1.0f - v) + (cuffEaseScale - 1.0f) * e * v);
+        return chainSec(body_, arm, v * sl.u, e + sl.root_ease_m * (1.0f - v) + (sl.cuff_ease_scale - 1.0f) * e * v);
       };
       const std::vector<Loop> sleeve = tube(m, samplePath(apath, h, counter()), Ka);
       stitch(loop, sleeve.front(), m);
