@@ -192,7 +192,8 @@ INSTANTIATE_TEST_SUITE_P(SharedData, ArmClearanceOnRecording,
                                            "kinect_v2_msft_labanotation/Ges02_balancinghands.csv",
                                            "kinect_v2_msft_labanotation/Ges04_comehere.csv",
                                            "kinect_v2_msft_labanotation/KinectReader_joints_closerange.csv",
-                                           "cmu_mocap_bvh/131_01.bvh", "cmu_mocap_bvh/131_03.bvh"));
+                                           "cmu_mocap_bvh/131_01.bvh", "cmu_mocap_bvh/131_03.bvh"),
+                         [](const ::testing::TestParamInfo<const char*>& info) { return test::takeTestName(info.param); });
 
 TEST(ArmClearanceOnRecording, Ges01sArmsRunInsideTheTorsoOnTheBones) {
   // What the push is for: without it, the main job's take has upper-arm ring points inside the

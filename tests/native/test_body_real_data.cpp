@@ -83,13 +83,7 @@ TEST_P(BodyOnRecording, MeshClosedFiniteAndPlausibleOnEveryFrame) {
 }
 
 INSTANTIATE_TEST_SUITE_P(SharedData, BodyOnRecording, ::testing::ValuesIn(kTakes),
-                         [](const ::testing::TestParamInfo<Take>& info) {
-                           std::string name = info.param.file;
-                           name = name.substr(name.find('/') + 1);
-                           name = name.substr(0, name.find('.'));
-                           std::replace_if(name.begin(), name.end(), [](char ch) { return !std::isalnum(static_cast<unsigned char>(ch)); }, '_');
-                           return name;
-                         });
+                         [](const ::testing::TestParamInfo<Take>& info) { return test::takeTestName(info.param.file); });
 
 }  // namespace
 }  // namespace drape

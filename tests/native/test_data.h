@@ -1,6 +1,8 @@
 // Where the tests find real data: ../shared/data beside the checkout (or $DRAPE_SHARED_DATA).
 #pragma once
 
+#include <algorithm>
+#include <cctype>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
@@ -16,6 +18,15 @@ inline std::string sharedDataDir() {
 inline std::string sharedFile(const std::string& relative) {
   const std::filesystem::path p = std::filesystem::path(sharedDataDir()) / relative;
   return std::filesystem::exists(p) ? p.string() : std::string();
+}
+
+// A parameterised test's name for a shared file: the file's stem, every character but letters and
+// digits made '_' ("cmu_mocap_bvh/scaled_131_01.bvh" -> "scaled_131_01"), so CTest's names stay
+// the same from run to run and patterns such as "*/Ges02*" select takes.
+inline std::string takeTestName(const std::string& relative) {
+  std::string name = std::filesystem::path(relative).stem().string();
+  std::replace_if(name.begin(), name.end(), [](char ch) { return !std::isalnum(static_cast<unsigned char>(ch)); }, '_');
+  return name;
 }
 
 }  // namespace drape::test

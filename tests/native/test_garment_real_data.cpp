@@ -200,11 +200,7 @@ TEST_P(LongSleeveByKindOnRecording, KeepsItsSleevesAtFifteenHundredParticles) { 
 
 INSTANTIATE_TEST_SUITE_P(SharedData, LongSleeveByKindOnRecording,
                          ::testing::Values("cmu_mocap_bvh/131_03.bvh", "cmu_mocap_bvh/scaled_131_03.bvh"),
-                         [](const ::testing::TestParamInfo<const char*>& info) {
-                           std::string name = info.param;
-                           name = name.substr(name.find('/') + 1);
-                           return name.substr(0, name.find('.'));
-                         });
+                         [](const ::testing::TestParamInfo<const char*>& info) { return test::takeTestName(info.param); });
 
 INSTANTIATE_TEST_SUITE_P(SharedData, TrousersByKindOnRecording,
                          ::testing::Values("kinect_v2_msft_labanotation/Ges01_wavehand.csv",
@@ -217,13 +213,7 @@ INSTANTIATE_TEST_SUITE_P(SharedData, TrousersByKindOnRecording,
                          });
 
 INSTANTIATE_TEST_SUITE_P(SharedData, GarmentOnRecording, ::testing::ValuesIn(kTakes),
-                         [](const ::testing::TestParamInfo<Take>& info) {
-                           std::string name = info.param.file;
-                           name = name.substr(name.find('/') + 1);
-                           name = name.substr(0, name.find('.'));
-                           std::replace_if(name.begin(), name.end(), [](char ch) { return !std::isalnum(static_cast<unsigned char>(ch)); }, '_');
-                           return name;
-                         });
+                         [](const ::testing::TestParamInfo<Take>& info) { return test::takeTestName(info.param.file); });
 
 }  // namespace
 }  // namespace drape

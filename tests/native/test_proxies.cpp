@@ -134,12 +134,8 @@ TEST_P(ProxiesOnRecording, DrapeRuleFitsTheBodyWithinTenMillimetres) {
 float shoulderTopGapMm(const BodyModel& body, const std::vector<Ellipsoid>& e, size_t count) {
   const int K = body.ringPoints();
   const int top = body.chainFirstRing(Chain::Torso) + body.chainRingCount(Chain::Torso) - 1;
-  auto outside = [&](const Vec3& p) {
-    float d = std::numeric_limits<float>::infinity();
-    for (size_t k = 0; k < count && d > 0.0f; ++k)
-      d = std::min(d, e[k].implicit(p) < 0.0f ? 0.0f : ellipsoidSurfacePoint(e[k], p).distance);
-    return d;
-  };
+  std::vector<float> scratch;
+  auto outside = [&](const Vec3& p) { return distanceOutsideUnion(e.data(), count, p, scratch); };
   float worst = 0.0f;
   for (bool left : {false, true}) {
     const std::vector<uint32_t>& t = body.shoulderTriangles(left);
@@ -216,12 +212,8 @@ void hipStitchGapsMm(const BodyModel& body, const std::vector<Ellipsoid>& e, siz
   const int ringVertices = static_cast<int>(body.rings().size()) * K;
   const int hip = body.chainFirstRing(Chain::Torso);
   const int thighs[2] = {body.chainFirstRing(Chain::LegL), body.chainFirstRing(Chain::LegR)};
-  auto outside = [&](const Vec3& p) {
-    float d = std::numeric_limits<float>::infinity();
-    for (size_t k = 0; k < count && d > 0.0f; ++k)
-      if (k != skip) d = std::min(d, e[k].implicit(p) < 0.0f ? 0.0f : ellipsoidSurfacePoint(e[k], p).distance);
-    return 1000.0f * d;
-  };
+  std::vector<float> scratch;
+  auto outside = [&](const Vec3& p) { return 1000.0f * distanceOutsideUnion(e.data(), count, p, scratch, skip); };
   const auto& t = body.indices();
   const auto& x = body.positions();
   for (size_t i = 0; i + 2 < t.size(); i += 3) {
@@ -340,7 +332,8 @@ INSTANTIATE_TEST_SUITE_P(SharedData, ProxiesOnRecording,
                                            Take{"kinect_v2_msft_labanotation/Ges04_comehere.csv"},
                                            Take{"kinect_v2_msft_labanotation/KinectReader_joints_closerange.csv"},
                                            Take{"cmu_mocap_bvh/scaled_131_01.bvh"},
-                                           Take{"cmu_mocap_bvh/scaled_131_03.bvh"}));
+                                           Take{"cmu_mocap_bvh/scaled_131_03.bvh"}),
+                         [](const ::testing::TestParamInfo<Take>& info) { return test::takeTestName(info.param.file); });
 
 }  // namespace
 }  // namespace drape

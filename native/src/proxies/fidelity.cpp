@@ -72,6 +72,29 @@ EllipsoidSurfacePoint ellipsoidSurfacePoint(const Ellipsoid& el, const Vec3& p) 
   return out;
 }
 
+float distanceOutsideUnion(const Ellipsoid* ellipsoids, size_t count, const Vec3& p, std::vector<float>& box_scratch,
+                           size_t skip) {
+  for (size_t j = 0; j < count; ++j)
+    if (j != skip && containsPoint(ellipsoids[j].bounds_min, ellipsoids[j].bounds_max, p) &&
+        ellipsoids[j].implicit(p) < 0.0f)
+      return 0.0f;
+  // Nearest box first, so the remaining boxes prune against a good bound.
+  box_scratch.resize(count);
+  size_t first = count;
+  for (size_t j = 0; j < count; ++j) {
+    if (j == skip) continue;
+    box_scratch[j] = boxDistance(p, ellipsoids[j].bounds_min, ellipsoids[j].bounds_max);
+    if (first == count || box_scratch[j] < box_scratch[first]) first = j;
+  }
+  if (first == count) return kInf;
+  float best = ellipsoidSurfacePoint(ellipsoids[first], p).distance;
+  for (size_t j = 0; j < count; ++j) {
+    if (j == first || j == skip || !(box_scratch[j] < best)) continue;
+    best = std::min(best, ellipsoidSurfacePoint(ellipsoids[j], p).distance);
+  }
+  return best;
+}
+
 FidelityReport measureFidelity(const std::vector<Vec3>& body_positions,
                                const std::vector<uint32_t>& body_indices,
                                const Ellipsoid* ellipsoids, int count, const TriangleBvh& bvh,
@@ -111,26 +134,7 @@ FidelityReport measureFidelity(const std::vector<Vec3>& body_positions,
   std::vector<float> box_distance(m, 0.0f);
   int outside_count = 0;
   for (size_t v = 0; v < n; ++v) {
-    const Vec3& p = samples[v];
-    bool inside = false;
-    for (size_t j = 0; j < m && !inside; ++j)
-      inside = containsPoint(ell[j].bounds_min, ell[j].bounds_max, p) && ell[j].implicit(p) < 0.0f;
-    float best = kInf;
-    if (!inside) {
-      // Nearest box first, so the remaining boxes prune against a good bound.
-      size_t first = 0;
-      for (size_t j = 0; j < m; ++j) {
-        box_distance[j] = boxDistance(p, ell[j].bounds_min, ell[j].bounds_max);
-        if (box_distance[j] < box_distance[first]) first = j;
-      }
-      if (m > 0) best = ellipsoidSurfacePoint(ell[first], p).distance;
-      for (size_t j = 0; j < m; ++j) {
-        if (j == first || !(box_distance[j] < best)) continue;
-        best = std::min(best, ellipsoidSurfacePoint(ell[j], p).distance);
-      }
-    } else {
-      best = 0.0f;
-    }
+    const float best = distanceOutsideUnion(ell.data(), m, samples[v], box_distance);
     outside[v] = best;
     if (!(best <= kFidelityOutsideMm * 1e-3f)) ++outside_count;
   }

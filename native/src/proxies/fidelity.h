@@ -59,6 +59,14 @@ FidelityReport measureFidelity(const std::vector<Vec3>& body_positions,
                                const Ellipsoid* ellipsoids, int count, const TriangleBvh& bvh,
                                int samples_per_ellipsoid = 256);
 
+// Distance from p to the union of ellipsoids[0, count) but `skip` (SIZE_MAX: none), metres: 0 when
+// p is inside one of them, +inf when none is left. The ellipsoids' bounds must be current
+// (refresh()); `box_scratch` is resized as needed (pass the same vector to reuse its memory). The
+// per-sample distance of measureFidelity's body -> union direction, for callers that measure
+// parts of a union (tests of the fills).
+float distanceOutsideUnion(const Ellipsoid* ellipsoids, size_t count, const Vec3& p, std::vector<float>& box_scratch,
+                           size_t skip = SIZE_MAX);
+
 // Closest point on the ellipsoid's surface to p (inside or outside), and the unsigned distance.
 // closestPointOnEllipsoid (proxies/closest_point.h) in the ellipsoid frame. Reads only centre, rotation and radii (no refresh()
 // needed). Radii that are not all positive and finite give the centre and |p - centre|.
