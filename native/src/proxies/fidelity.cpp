@@ -14,6 +14,9 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 // ellipsoid's unit space (|q| < 1 - kStrictlyInside): about 0.1 mm for a 10 cm radius, so samples
 // on the seam where two surfaces cross are kept.
 constexpr float kStrictlyInside = 1e-3f;
+// How far outside its ellipsoid's box a union sample may fall by rounding, metres (far more than
+// it does: float rounding of a 1 m coordinate is 1e-7 m).
+constexpr float kSampleBoxSlackM = 1e-3f;
 
 float boxDistance(const Vec3& p, const Vec3& lo, const Vec3& hi) {
   const Vec3 d = (lo - p).cwiseMax(p - hi).cwiseMax(0.0f);
@@ -154,15 +157,25 @@ FidelityReport measureFidelity(const std::vector<Vec3>& body_positions,
   dist.reserve(m * static_cast<size_t>(per));
   weight.reserve(m * static_cast<size_t>(per));
   const float solid_angle = per > 0 ? 4.0f * kPi / static_cast<float>(per) : 0.0f;
+  std::vector<size_t> near;
+  near.reserve(m);
   for (size_t i = 0; i < m; ++i) {
     const Ellipsoid& e = ell[i];
     const float volume_factor = e.radii.prod();
+    // Only an ellipsoid whose box meets this one's can hold its samples (they lie in its box, up
+    // to rounding: the slack), so the others are left out once, not per sample; same answer.
+    const Vec3 lo = e.bounds_min.array() - kSampleBoxSlackM, hi = e.bounds_max.array() + kSampleBoxSlackM;
+    near.clear();
+    for (size_t j = 0; j < m; ++j)
+      if (j != i && !(lo.array() > ell[j].bounds_max.array()).any() && !(ell[j].bounds_min.array() > hi.array()).any())
+        near.push_back(j);
     for (int k = 0; k < per; ++k) {
       const Vec3 u = fibonacciSpherePoint(k, per);
       const Vec3 x = e.fromUnit(u);
       bool covered = false;
-      for (size_t j = 0; j < m && !covered; ++j) {
-        if (j == i || !containsPoint(ell[j].bounds_min, ell[j].bounds_max, x)) continue;
+      for (size_t c = 0; c < near.size() && !covered; ++c) {
+        const size_t j = near[c];
+        if (!containsPoint(ell[j].bounds_min, ell[j].bounds_max, x)) continue;
         covered = ell[j].toUnit(x).norm() < 1.0f - kStrictlyInside;
       }
       if (covered) continue;
