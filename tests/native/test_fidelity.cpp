@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <random>
 #include <vector>
@@ -251,6 +252,43 @@ TEST(Fidelity, EllipsoidDistanceMatchesBruteForce) {
   Ellipsoid flat = sphere(kCentre, 0.1f);
   flat.radii.z() = 0.0f;
   EXPECT_NEAR(ellipsoidSurfacePoint(flat, kCentre + Vec3(0.3f, 0, 0)).distance, 0.3f, 1e-6f);
+}
+
+// distanceOutsideUnion prunes by boxes (nearest first, farther boxes skipped): the same distance
+// as the minimum over every ellipsoid, with one left out or none, and 0 inside any.
+TEST(Fidelity, DistanceOutsideUnionIsTheMinimumOverTheEllipsoids) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> radius(0.03f, 0.2f), unit(-1.0f, 1.0f), angle(0.0f, 6.28f);
+  std::vector<Ellipsoid> e(12);
+  for (Ellipsoid& el : e) {
+    el.centre = kCentre + 0.4f * test::draw3(unit, rng);
+    const float turn = angle(rng);
+    const Vec3 axis = test::draw3(unit, rng).normalized();
+    el.rotation = Eigen::AngleAxisf(turn, axis).toRotationMatrix();
+    el.radii = test::draw3(radius, rng);
+    el.refresh();
+  }
+  std::vector<float> scratch;
+  int inside = 0, outside = 0;
+  const int points = test::repeatsUnderSanitizers(400, 4);
+  for (int i = 0; i < points; ++i) {
+    const Vec3 p = kCentre + 0.6f * test::draw3(unit, rng);
+    for (const size_t skip : {SIZE_MAX, static_cast<size_t>(i) % e.size()}) {
+      float brute = std::numeric_limits<float>::infinity();
+      for (size_t k = 0; k < e.size(); ++k) {
+        if (k == skip) continue;
+        brute = std::min(brute, e[k].implicit(p) < 0.0f ? 0.0f : ellipsoidSurfacePoint(e[k], p).distance);
+      }
+      const float d = distanceOutsideUnion(e.data(), e.size(), p, scratch, skip);
+      EXPECT_EQ(d, brute) << "point " << i << " skip " << skip;
+      (d == 0.0f ? inside : outside)++;
+    }
+  }
+  EXPECT_GT(inside, points / 20);
+  EXPECT_GT(outside, points / 2);
+  // Nothing left: +inf (every ellipsoid skipped, or none given).
+  EXPECT_EQ(distanceOutsideUnion(e.data(), 1, kCentre, scratch, 0), std::numeric_limits<float>::infinity());
+  EXPECT_EQ(distanceOutsideUnion(nullptr, 0, kCentre, scratch), std::numeric_limits<float>::infinity());
 }
 
 TEST(Fidelity, FibonacciSphereIsUnitAndBalanced) {

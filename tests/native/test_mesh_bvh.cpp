@@ -343,8 +343,11 @@ TEST(TriangleBvh, WindingCountsOverlappingPartsAndRetriesRaysThroughEdges) {
   EXPECT_EQ(bvh.winding(Vec3(0.5f, 0.5f, 0.5f)), 1);
   EXPECT_EQ(bvh.winding(Vec3(1.5f, 0.5f, 0.5f)), 0);
   EXPECT_EQ(bvh.winding(Vec3(-0.2f, -0.2f, -0.2f)), 0);  // its rays pass the cube's corner region
-  // A point whose first ray runs through the corner (1, 1, 1) (exactly, up to rounding) and one
-  // whose first ray runs along a face diagonal's edge: both need another direction.
+  // Points whose ray along the first fixed direction d0 runs through the corner (1, 1, 1) (exactly,
+  // up to rounding) or along the top face's diagonal. The first ray tried is the one of six that
+  // leaves the box soonest (mesh_bvh.h): for the corner probes another direction (no direction of
+  // the six leaves through that corner soonest), for the diagonal probe d0 (it leaves through the
+  // top face), which grazes the diagonal's edge and needs another direction.
   const Vec3 d0 = Vec3(0.2673f, 0.5345f, 0.8018f).normalized();
   EXPECT_EQ(bvh.winding(Vec3(1, 1, 1) - 0.3f * d0), 1);
   EXPECT_EQ(bvh.winding(Vec3(1, 1, 1) + 0.3f * d0), 0);

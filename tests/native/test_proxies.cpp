@@ -333,7 +333,9 @@ INSTANTIATE_TEST_SUITE_P(SharedData, ProxiesOnRecording,
                                            Take{"kinect_v2_msft_labanotation/KinectReader_joints_closerange.csv"},
                                            Take{"cmu_mocap_bvh/scaled_131_01.bvh"},
                                            Take{"cmu_mocap_bvh/scaled_131_03.bvh"}),
-                         [](const ::testing::TestParamInfo<Take>& info) { return test::takeTestName(info.param.file); });
+                         [](const ::testing::TestParamInfo<Take>& info) {
+                           return test::takeTestName(info.param.file);
+                         });
 
 }  // namespace
 }  // namespace drape

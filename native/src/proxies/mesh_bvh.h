@@ -101,8 +101,8 @@ class TriangleBvh {
   // (body/mesh_metrics.h) rounded, at the cost of a ray query instead of a sum over every
   // triangle. The first ray is the one of six fixed directions that leaves the tree's box soonest
   // (the fewest boxes to pass). A ray that passes within a rounding tolerance of an edge or a
-  // vertex is discarded for another direction; after four such rays the solid-angle sum decides. 0 for an empty tree
-  // or a non-finite p.
+  // vertex is discarded for another direction; after four such rays the solid-angle sum decides.
+  // 0 for an empty tree or a non-finite p.
   int winding(const Vec3& p) const;
   // Depth of p inside the solid the mesh bounds: its distance to the mesh where winding(p) >= 1,
   // else 0. Unlike -signedDistance, a point outside the solid whose closest point lies on a buried
