@@ -31,6 +31,15 @@ inline bool containsPoint(const Vec3& mn, const Vec3& mx, const Vec3& p) {
   return inside != 0u;
 }
 
+// Whether the boxes [lo, hi] and [mn, mx] meet (touching counts; false for a NaN coordinate), with
+// & as containsPoint.
+inline bool overlaps(const Vec3& lo, const Vec3& hi, const Vec3& mn, const Vec3& mx) {
+  const unsigned overlap = unsigned(lo.x() <= mx.x()) & unsigned(hi.x() >= mn.x()) &
+                           unsigned(lo.y() <= mx.y()) & unsigned(hi.y() >= mn.y()) &
+                           unsigned(lo.z() <= mx.z()) & unsigned(hi.z() >= mn.z());
+  return overlap != 0u;
+}
+
 // A unit vector perpendicular to `n` (n need not be normalised but must be non-zero).
 inline Vec3 anyPerpendicular(const Vec3& n) {
   const Vec3 a = std::fabs(n.x()) < 0.9f * n.norm() ? Vec3::UnitX() : Vec3::UnitY();

@@ -33,14 +33,6 @@ inline int lowestBit(uint64_t m) {
 #endif
 }
 
-// Box tests with & rather than && (containsPoint, common/math.h): no branch per comparison.
-inline bool overlaps(const Vec3& lo, const Vec3& hi, const Vec3& mn, const Vec3& mx) {
-  const unsigned overlap = unsigned(lo.x() <= mx.x()) & unsigned(hi.x() >= mn.x()) &
-                           unsigned(lo.y() <= mx.y()) & unsigned(hi.y() >= mn.y()) &
-                           unsigned(lo.z() <= mx.z()) & unsigned(hi.z() >= mn.z());
-  return overlap != 0u;
-}
-
 // Cell coordinates of a point (4-wide: the w lane is ignored), clamped to the grid. Monotone in
 // each coordinate, so a point inside two boxes lies in a cell both boxes' cell ranges include.
 // SSE spelled out as Eigen's packet code has it (max(x, 0) as _mm_max_ps(0, x), min(x, top) as
@@ -103,7 +95,7 @@ inline bool contains4(const Vec4& mn, const Vec4& mx, const Vec4& p) {
 // The broad phase's candidates (declared in collision.h).
 DRAPE_ALWAYS_INLINE bool EllipsoidCollider::gather(const Vec3& lo, const Vec3& hi, bool use_grid,
                                                    const uint64_t* allowed, Candidates& c) const {
-  if (!collision_internal::overlaps(lo, hi, grid_min_, grid_max_)) return false;  // outside every swept box
+  if (!overlaps(lo, hi, grid_min_, grid_max_)) return false;  // outside every swept box
   c.all = !use_grid;
   c.allowed = allowed;
   if (c.all) return true;
@@ -167,7 +159,7 @@ inline bool EllipsoidCollider::mayTouch(const Eigen::Vector4f* positions, const 
   if (!containsPoint(grid_min_, grid_max_, x)) {
     if (!swept) return false;
     const Vec3 p0 = previous[i].head<3>();
-    if (!collision_internal::overlaps(x.cwiseMin(p0), x.cwiseMax(p0), grid_min_, grid_max_)) return false;
+    if (!overlaps(x.cwiseMin(p0), x.cwiseMax(p0), grid_min_, grid_max_)) return false;
   }
   return isFinite(x);
 }

@@ -167,8 +167,7 @@ FidelityReport measureFidelity(const std::vector<Vec3>& body_positions,
     const Vec3 lo = e.bounds_min.array() - kSampleBoxSlackM, hi = e.bounds_max.array() + kSampleBoxSlackM;
     near.clear();
     for (size_t j = 0; j < m; ++j)
-      if (j != i && !(lo.array() > ell[j].bounds_max.array()).any() && !(ell[j].bounds_min.array() > hi.array()).any())
-        near.push_back(j);
+      if (j != i && overlaps(lo, hi, ell[j].bounds_min, ell[j].bounds_max)) near.push_back(j);
     for (int k = 0; k < per; ++k) {
       const Vec3 u = fibonacciSpherePoint(k, per);
       const Vec3 x = e.fromUnit(u);
