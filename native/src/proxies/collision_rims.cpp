@@ -20,7 +20,7 @@ namespace {
 // closest point nearer the centre than 0.87 of the way to the surface) is pushed: a limb lying
 // across the edge, not a short chord grazing the surface, which the margin already covers and
 // which the particles' own contacts answer. Measured over the 240-run quality matrix at 800-2 500
-// particles (docs/collision.md): deeper thresholds (0.5) kept fewer sleeves on at low
+// particles (docs/garments.md, "Rim edges"): deeper thresholds (0.5) kept fewer sleeves on at low
 // resolutions, shallower ones (1.0) moved the default resolutions' figures.
 constexpr float kRimDeep2 = 0.75f;
 // The edge's closest point within this fraction of an end: the end particle's own contact.
