@@ -236,6 +236,12 @@ bool buildGarmentTopology(const float* positions, size_t vertex_count, const uin
   colourConstraints(t.shear, vertex_count, true);
   colourConstraints(t.bend, vertex_count, true);
   colourConstraints(t.tether, vertex_count, false);
+  for (const std::vector<uint32_t>& loop : boundaryLoops(t.triangles, vertex_count))
+    for (size_t k = 0; k < loop.size(); ++k) {
+      const uint32_t i = loop[k], j = loop[(k + 1) % loop.size()];
+      addConstraint(t.rims, std::min(i, j), std::max(i, j), dist(i, j));
+    }
+  colourConstraints(t.rims, vertex_count, true);
   out = std::move(t);
   error.clear();
   return true;

@@ -53,6 +53,10 @@ struct GarmentTopology {
   std::vector<uint32_t> pinned;      // pinned vertex indices, sorted, unique
   std::vector<uint32_t> triangles;   // 3 indices per triangle (as given)
   DistanceConstraints stretch, shear, bend, tether;
+  // The edges of the mesh's closed boundary loops (boundaryLoops: cuffs, hems, collar), coloured
+  // like the constraints; rest = rest length. Not constraints: the solvers collide them as edges
+  // (EllipsoidCollider::collideRims).
+  DistanceConstraints rims;
 
   size_t particleCount() const { return rest_positions.size(); }
 };

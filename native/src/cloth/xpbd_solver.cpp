@@ -615,7 +615,10 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
   // 3. Collision against the tracking ellipsoids.
   if (collider != nullptr) {
     const Clock::time_point t0 = timing_ ? Clock::now() : Clock::time_point{};
-    const CollisionStats cs = collider->collide(x, span_prev ? span_prev : prev, n, p.collision);
+    CollisionStats cs = collider->collide(x, span_prev ? span_prev : prev, n, p.collision);
+    const DistanceConstraints& rims = topology_.rims;
+    if (p.collision.rims && rims.size() > 0)
+      collider->collideRims(x, n, rims.a.data(), rims.b.data(), rims.size(), p.collision, cs);
     collision_stats_.tests += cs.tests;
     collision_stats_.contacts += cs.contacts;
     collision_stats_.swept_catches += cs.swept_catches;

@@ -38,6 +38,8 @@ struct CollisionParams {
   // AVX: the same tests in the same order and arithmetic per particle, so the same results
   // (bit-identical); off = one particle at a time. docs/collision.md, "Eight particles at once".
   bool batch8 = true;
+  // The cloth solvers collide a garment's rim edges too (collideRims) after its particles.
+  bool rims = true;
 };
 
 struct CollisionStats {
@@ -84,6 +86,16 @@ class EllipsoidCollider {
                          const CollisionParams& params) const;
 
   int count() const { return static_cast<int>(shapes_.size()); }
+
+  // Rim edges (a[e], b[e]) of a garment's boundary loops against the end ellipsoids, after
+  // collide(): an edge with an ellipsoid deep across its interior (a limb between two cuff
+  // particles) is pushed off it, its two ends shared by barycentric weight and inverse mass, then
+  // each moved end is collided again (discretely), so no particle is left inside. An edge meets
+  // only the ellipsoids both its particles may touch (setGroups). Edges are answered in order,
+  // each seeing the ones before it: callers that run them in parallel colour them (no two edges
+  // of a colour share a particle). Returns the edges moved. proxies/collision_rims.cpp.
+  size_t collideRims(Eigen::Vector4f* positions, size_t count, const uint32_t* a, const uint32_t* b, size_t edges,
+                     const CollisionParams& params, CollisionStats& stats) const;
 
   // Collision groups. ellipsoid_groups: the groups of each ellipsoid (bits 1 << body chain: one,
   // or two for the shoulder fills, proxies/proxy_builder.h), in the order setEllipsoids receives them; particle_masks: one byte per particle, the
