@@ -45,7 +45,7 @@ if(DRAPE_UNITY_TESTS AND TARGET drape_tests)
   # test_fidelity.cpp, Take in test_skeleton_tracker.cpp. test_cloth_strain_limit.cpp and
   # test_arm_clearance.cpp clash with nothing, but a file added in the middle of the sorted list
   # regroups every batch after it, and regrouped files met other files' names (Body in test_garment_obj.cpp and
-  # test_garment_templates.cpp): kept out, the batches stay as they were.
+  # test_garment_templates.cpp, since renamed ObjTestBody): kept out, the batches stay as they were.
   set_source_files_properties(
       "${PROJECT_SOURCE_DIR}/tests/native/test_arm_clearance.cpp"
       "${PROJECT_SOURCE_DIR}/tests/native/test_cloth_strain_limit.cpp"

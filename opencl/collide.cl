@@ -324,3 +324,71 @@ inline float4 collide_particle(const CollideSpan* sp, uint mask, float4 p, float
   const float3 y = resolve_particle(sp, mask, x, x0, has_prev, st);
   return (float4)(y, p.w);
 }
+
+/* EllipsoidCollider::collideRims for one rim edge (native/src/proxies/collision_rims.cpp): the
+ * same tests and arithmetic, every shape of the span in index order behind its group and box
+ * tests (the CPU's grid only skips shapes that box test rejects). *pa and *pb are the edge's
+ * particles (w = inverse mass), updated; true when the edge was pushed. The caller runs the edges
+ * of one colour in parallel (no two share a particle). */
+#define DCL_RIM_DEEP2 0.75f
+#define DCL_RIM_END_T 0.02f
+#define DCL_LIMB_ELONGATION 1.5f
+inline bool collide_rim(const CollideSpan* sp, uint mask_a, uint mask_b, float4* pa, float4* pb,
+                        CollideCounters* st) {
+  const float wa = (*pa).w > 0.0f ? (*pa).w : 0.0f, wb = (*pb).w > 0.0f ? (*pb).w : 0.0f;
+  if (wa == 0.0f && wb == 0.0f) return false;
+  float3 xa = (*pa).xyz, xb = (*pb).xyz;
+  if (!all(isfinite(xa)) || !all(isfinite(xb))) return false;
+  const bool grouped = (sp->flags & DRAPE_CL_GROUPED) != 0u;
+  const uint mask = mask_a & mask_b;
+  if (grouped && mask == 0u) return false;
+  if (!box_overlaps(fmin(xa, xb), fmax(xa, xb), sp->bound_min, sp->bound_max)) return false;
+  bool moved = false;
+  for (uint k = 0; k < sp->count; ++k) {
+    __global const DrapeClShape* s = sp->shapes + k;
+    if (!shape_allowed(s, sp->flags, mask)) continue;
+    if (!box_overlaps(fmin(xa, xb), fmax(xa, xb), s->end_min.xyz, s->end_max.xyz)) continue;
+    ++st->tests;
+    const float3 q0 = to_unit_end(s, xa), q1 = to_unit_end(s, xb);
+    const float3 d = q1 - q0;
+    const float dd = sq(d);
+    if (!(dd > 1e-12f)) continue;
+    const float t = clamp(-dot(q0, d) / dd, 0.0f, 1.0f);
+    if (t <= DCL_RIM_END_T || t >= 1.0f - DCL_RIM_END_T) continue;
+    const float3 q = q0 + t * d;
+    const float r2 = sq(q);
+    if (!(r2 < DCL_RIM_DEEP2) || !(r2 > 1e-12f)) continue;
+    float3 target = q * (1.0f / sqrt(r2));
+    const float3 r = s->radii.xyz;
+    const int axis = (r.y > r.x) ? (r.z > r.y ? 2 : 1) : (r.z > r.x ? 2 : 0);
+    const float longest = axis == 0 ? r.x : axis == 1 ? r.y : r.z;
+    const float middle = axis == 0 ? fmax(r.y, r.z) : axis == 1 ? fmax(r.z, r.x) : fmax(r.x, r.y);
+    if (longest > DCL_LIMB_ELONGATION * middle) {
+      const float qa = axis == 0 ? q.x : axis == 1 ? q.y : q.z;
+      float3 across = q;
+      if (axis == 0) across.x = 0.0f;
+      else if (axis == 1) across.y = 0.0f;
+      else across.z = 0.0f;
+      const float a2 = sq(across);
+      if (!(a2 > 1e-8f)) continue;
+      target = across * sqrt((1.0f - qa * qa) / a2);
+      if (axis == 0) target.x = qa;
+      else if (axis == 1) target.y = qa;
+      else target.z = qa;
+    }
+    const float3 delta = mul_cols(s->end_f0, s->end_f1, s->end_f2, target - q);
+    const float ca = wa * (1.0f - t), cb = wb * t;
+    const float den = ca * (1.0f - t) + cb * t;
+    if (!(den > 0.0f)) continue;
+    xa += (ca / den) * delta;
+    xb += (cb / den) * delta;
+    moved = true;
+    ++st->contacts;
+  }
+  if (!moved) return false;
+  if (wa > 0.0f) xa = resolve_particle(sp, grouped ? mask_a : 0xFFu, xa, xa, false, st);
+  if (wb > 0.0f) xb = resolve_particle(sp, grouped ? mask_b : 0xFFu, xb, xb, false, st);
+  *pa = (float4)(xa, (*pa).w);
+  *pb = (float4)(xb, (*pb).w);
+  return true;
+}

@@ -72,7 +72,8 @@ typedef struct {
    * here instead of every constraint on the host and its upload. */
   float alpha[4];
   dcl_u32 kind_end[2];        /* distance group index where the first / second kind's colours end */
-  dcl_u32 pad2, pad3;
+  dcl_u32 rim_group_offset;   /* into the group table: the rim edges' colours (GarmentTopology::rims) */
+  dcl_u32 rim_groups;         /* 0: no rim edges collided (none, or CollisionParams::rims off) */
 } DrapeClGarment;
 
 /* A distance or tether constraint: a and b are particle indices within the garment; w_sum =
@@ -112,6 +113,17 @@ typedef struct {
 inline float dcl_inv_w(float w_sum, float alpha) {
   const float w = w_sum + alpha;
   return w > 0.0f ? 1.0f / w : 0.0f;
+}
+
+/* A particle's velocity from where a substep leaves it (the CPU solver's update after the
+ * collision): (x - prev) * velocity_scale, clamped to max_speed (w - w = 0). */
+inline float4 dcl_velocity(__global const DrapeClGarment* g, float4 xi, float4 pi) {
+  float4 v = (xi - pi) * g->velocity_scale;
+  if (g->max_speed2 > 0.0f) {
+    const float s2 = dot(v, v);
+    if (s2 > g->max_speed2) v *= g->max_speed / sqrt(s2);
+  }
+  return v;
 }
 
 /* The alpha~ of distance colour group `group` (or of the tethers) of garment g: the distance

@@ -130,6 +130,27 @@ void DCL_FRAME_BODY(__global const DrapeClGarment* g, DCL_XS float4* x, __global
       }
       vel[i] = v;
     }
+    /* 3b. The rim edges (collideRims) after every particle's collision, colour by colour; the
+     * particles they move get their velocity from where they end, as the CPU's update after them. */
+    if (collide && sp.count > 0u && g->rim_groups > 0u) {
+      barrier(CLK_LOCAL_MEM_FENCE | CLK_GLOBAL_MEM_FENCE);
+      const bool grouped = (g->flags & DRAPE_CL_GROUPED) != 0u;
+      for (uint c = 0; c < g->rim_groups; ++c) {
+        const uint begin = groups[g->rim_group_offset + c], end = groups[g->rim_group_offset + c + 1u];
+        for (uint k = begin + lid; k < end; k += lsize) {
+          const DrapeClConstraint r = constraints[k];
+          float4 pa = x[r.a], pb = x[r.b];
+          const uint ma = grouped ? (uint)masks[g->particle_offset + r.a] : 0xFFu;
+          const uint mb = grouped ? (uint)masks[g->particle_offset + r.b] : 0xFFu;
+          if (!collide_rim(&sp, ma, mb, &pa, &pb, &st)) continue;
+          x[r.a] = pa;
+          x[r.b] = pb;
+          vel[r.a] = dcl_velocity(g, pa, prev[r.a]);
+          vel[r.b] = dcl_velocity(g, pb, prev[r.b]);
+        }
+        barrier(CLK_LOCAL_MEM_FENCE | CLK_GLOBAL_MEM_FENCE);
+      }
+    }
     if (collide) {
       span0 = s + 1;
       ++span;

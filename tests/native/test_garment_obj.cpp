@@ -183,10 +183,10 @@ TEST(GarmentObjReal, SourceWeightIsTheBodyProxyVolumeTimesDensity) {
 
 // ---- Fitting ----------------------------------------------------------------------------------
 
-struct Body {
+struct ObjTestBody {
   ResolvedShape shape;
   BodyModel model;
-  Body(float height, float weight, float arm_down = 35.0f, BodyModelParams params = {})
+  ObjTestBody(float height, float weight, float arm_down = 35.0f, BodyModelParams params = {})
       : shape(resolve(height, weight)), model(shape, params) {
     model.update(restPose(shape, arm_down));
   }
@@ -197,9 +197,9 @@ struct Body {
     return resolveShape(in);
   }
 };
-const Body& lightBody() { static const Body b(1.55f, 45.0f); return b; }
-const Body& defaultBody() { static const Body b(1.70f, 65.0f); return b; }
-const Body& heavyBody() { static const Body b(1.85f, 110.0f); return b; }
+const ObjTestBody& objLightBody() { static const ObjTestBody b(1.55f, 45.0f); return b; }
+const ObjTestBody& objDefaultBody() { static const ObjTestBody b(1.70f, 65.0f); return b; }
+const ObjTestBody& objHeavyBody() { static const ObjTestBody b(1.85f, 110.0f); return b; }
 
 // How the garment sits on the body: signed distance to the body mesh (negative inside; inside
 // from the winding number, since the body mesh intersects itself at the shoulders and crotch).
@@ -287,7 +287,7 @@ TEST(GarmentObjFit, SuitsSitOnLightDefaultAndHeavyBodies) {
     std::string err;
     std::vector<Vec3> placed;
     ASSERT_TRUE(placeObjOnSourceBody(m, paramsFor(s), placed, err)) << err;
-    for (const Body* b : {&lightBody(), &defaultBody(), &heavyBody()}) {
+    for (const ObjTestBody* b : {&objLightBody(), &objDefaultBody(), &objHeavyBody()}) {
       GarmentMesh g;
       ASSERT_TRUE(fitObjGarment(m, paramsFor(s), b->model, g, err)) << err;
       expectSane(m, g);
@@ -307,7 +307,7 @@ TEST(GarmentObjFit, SuitsSitOnLightDefaultAndHeavyBodies) {
 }
 
 TEST(GarmentObjFit, RetargetingBeatsPlainPlacementOnHeavyBody) {
-  const Body& heavy = heavyBody();
+  const ObjTestBody& heavy = objHeavyBody();
   for (const Suit& s : std::vector<Suit>(kSuits, kSuits + kSuitsToFit)) {
     LOAD_SUIT(m, s.file);
     std::string err;
@@ -337,9 +337,9 @@ TEST(GarmentObjFit, BlendedBindingKeepsNeighboursTogether) {
   std::vector<Vec3> placed;
   ASSERT_TRUE(placeObjOnSourceBody(m, p, placed, err)) << err;
   GarmentMesh blended, nearest;
-  ASSERT_TRUE(fitObjGarment(m, p, heavyBody().model, blended, err)) << err;
+  ASSERT_TRUE(fitObjGarment(m, p, objHeavyBody().model, blended, err)) << err;
   p.blend_m = 0.0f;
-  ASSERT_TRUE(fitObjGarment(m, p, heavyBody().model, nearest, err)) << err;
+  ASSERT_TRUE(fitObjGarment(m, p, objHeavyBody().model, nearest, err)) << err;
   const float worstBlended = edgeRatios(m, placed, blended.positions).back();
   const float worstNearest = edgeRatios(m, placed, nearest.positions).back();
   std::printf("heavy body, longest edge growth: %.2fx blended, %.2fx nearest segment only\n", worstBlended,
@@ -357,7 +357,7 @@ TEST(GarmentObjFit, SleevesFollowTheTargetArmAngle) {
   for (uint32_t i = 0; i < m.positions.size(); ++i) if (std::fabs(m.positions[i].x()) > 2.0f) sleeve.push_back(i);
   ASSERT_GT(sleeve.size(), 300u);
   for (float arm : {15.0f, 35.0f, 70.0f}) {
-    const Body b(1.70f, 65.0f, arm);
+    const ObjTestBody b(1.70f, 65.0f, arm);
     GarmentMesh g;
     ASSERT_TRUE(fitObjGarment(m, ObjFitParams{}, b.model, g, err)) << err;
     std::vector<Vec3> fitted, plain;
@@ -376,7 +376,7 @@ TEST(GarmentObjFit, PinsAreWaistbandsAndCollarsAndFollowTheirRings) {
     LOAD_SUIT(m, s.file);
     std::string err;
     const auto comps = components(m);
-    for (const Body* b : {&lightBody(), &heavyBody()}) {
+    for (const ObjTestBody* b : {&objLightBody(), &objHeavyBody()}) {
       GarmentMesh g;
       ASSERT_TRUE(fitObjGarment(m, paramsFor(s), b->model, g, err)) << err;
       expectSane(m, g);
@@ -418,10 +418,10 @@ TEST(GarmentObjFit, DenserRingLayoutsGiveTheSameFit) {
   BodyModelParams dense;
   dense.ring_points = 32;
   dense.rings_per_segment = 3;
-  const Body b(1.70f, 65.0f, 35.0f, dense);
+  const ObjTestBody b(1.70f, 65.0f, 35.0f, dense);
   GarmentMesh g, g0;
   ASSERT_TRUE(fitObjGarment(m, ObjFitParams{}, b.model, g, err)) << err;
-  ASSERT_TRUE(fitObjGarment(m, ObjFitParams{}, defaultBody().model, g0, err)) << err;
+  ASSERT_TRUE(fitObjGarment(m, ObjFitParams{}, objDefaultBody().model, g0, err)) << err;
   expectSane(m, g);
   std::vector<float> moved;
   for (size_t i = 0; i < g.positions.size(); ++i) moved.push_back((g.positions[i] - g0.positions[i]).norm());
@@ -465,7 +465,7 @@ TEST(GarmentObjFit, RejectsBadInputLeavingOutputUntouched) {
   g.positions.assign(1, Vec3(7, 7, 7));
   const auto rejects = [&](const ObjMesh& m, const ObjFitParams& p, const char* expect) {
     std::string err;
-    EXPECT_FALSE(fitObjGarment(m, p, defaultBody().model, g, err)) << expect;
+    EXPECT_FALSE(fitObjGarment(m, p, objDefaultBody().model, g, err)) << expect;
     EXPECT_NE(err.find(expect), std::string::npos) << "got '" << err << "'";
     EXPECT_EQ(g.positions.size(), 1u);
   };

@@ -512,6 +512,84 @@ TEST(OpenClKernels, StrainLimitMatchesCpuOnBothDevicePaths) {
   EXPECT_LT(stretch_on, stretch_off - 0.03f);  // and the limit took much of it out
 }
 
+// The rim edges (EllipsoidCollider::collideRims) on both device paths against XpbdSolver::step:
+// a sheet hanging from its top row and a thin upright rod moving through its hem between two hem
+// particles (the scene of CollideRims.AThinRodCatchesTheHemInsteadOfPassingThroughTheCloth), which
+// only the rim pass catches. The two device paths the same bits; the device within the CPU bounds
+// of frameMatchesXpbdStep; and the rims do act on the device: the hem is carried along with them
+// and left behind without.
+TEST(OpenClKernels, RimEdgesMatchCpuOnBothDevicePaths) {
+  DRAPE_REQUIRE_OPENCL(rt);
+  test::ClothGrid grid;
+  grid.nx = 12, grid.ny = 6;
+  grid.height = 0.5f;
+  grid.origin = Vec3(-0.5f, 0.0f, 0.0f);
+  TopologyParams tp;
+  for (uint32_t i = 0; i < static_cast<uint32_t>(grid.nx); ++i) tp.pinned.push_back(i);
+  const GarmentTopology t = test::clothGridTopology(grid, tp);
+  ASSERT_GT(t.rims.size(), 0u);
+  std::string err;
+  XpbdParams on;
+  XpbdParams off = on;
+  off.collision.rims = false;
+  XpbdSolver cpu(t), nudged[2] = {XpbdSolver(t), XpbdSolver(t)};
+  ASSERT_TRUE(cpu.setParams(on, err)) << err;
+  for (int k = 0; k < 2; ++k) {
+    ASSERT_TRUE(nudged[k].setParams(on, err)) << err;
+    for (size_t i = 0; i < t.particleCount(); ++i) nudged[k].mutablePositions()[i][k == 0 ? 0 : 2] += 1e-6f;
+  }
+  std::unique_ptr<ClXpbdSolver> group = ClXpbdSolver::create(rt, t, {}, {}, err);
+  ASSERT_TRUE(group) << err;
+  std::unique_ptr<ClXpbdSolver> phases = ClXpbdSolver::create(rt, t, {}, {}, err);
+  ASSERT_TRUE(phases) << err;
+  std::unique_ptr<ClXpbdSolver> without = ClXpbdSolver::create(rt, t, {}, {}, err);
+  ASSERT_TRUE(without) << err;
+  group->setPath(ClXpbdSolver::Path::WorkGroup);
+  phases->setPath(ClXpbdSolver::Path::Phases);
+  without->setPath(ClXpbdSolver::Path::WorkGroup);
+  ASSERT_TRUE(group->setParams(on, err)) << err;
+  ASSERT_TRUE(phases->setParams(on, err)) << err;
+  ASSERT_TRUE(without->setParams(off, err)) << err;
+  EllipsoidCollider collider;
+  const float x_mid = -0.5f + 5.5f / static_cast<float>(grid.nx - 1);
+  const size_t hem0 = static_cast<size_t>(grid.nx) * static_cast<size_t>(grid.ny - 1);
+  float chaos = 0.0f, carried = 0.0f, carried_without = 0.0f;
+  for (int f = 0; f < 20; ++f) {
+    const float z0 = -0.1f + 0.015f * static_cast<float>(f), z1 = z0 + 0.015f;
+    const Ellipsoid e0 = makeEllipsoid(Vec3(x_mid, -0.45f, z0), Vec3(0.01f, 0.2f, 0.01f), 0.0f, Vec3(0, 1, 0));
+    const Ellipsoid e1 = makeEllipsoid(Vec3(x_mid, -0.45f, z1), Vec3(0.01f, 0.2f, 0.01f), 0.0f, Vec3(0, 1, 0));
+    ASSERT_TRUE(cpu.setColliderMotion(&collider, &e0, &e1, 1, 0.004f, err));
+    ASSERT_TRUE(cpu.step(1.0f / 30.0f, 10));
+    for (XpbdSolver& s : nudged) {
+      ASSERT_TRUE(s.setColliderMotion(&collider, &e0, &e1, 1, 0.004f, err));
+      ASSERT_TRUE(s.step(1.0f / 30.0f, 10));
+    }
+    for (ClXpbdSolver* s : {group.get(), phases.get(), without.get()}) {
+      ASSERT_TRUE(s->setColliderMotion(&e0, &e1, 1, 0.004f, {}, err)) << err;
+      ASSERT_TRUE(s->step(1.0f / 30.0f, 10)) << s->lastError();
+    }
+    EXPECT_FALSE(group->usesPhases());
+    EXPECT_TRUE(phases->usesPhases());
+    float worst = 0.0f;
+    for (size_t i = 0; i < t.particleCount(); ++i) {
+      ASSERT_EQ(group->positions()[i], phases->positions()[i]) << "frame " << f << " particle " << i;
+      worst = std::max(worst, (group->positions()[i] - cpu.positions()[i]).head<3>().norm());
+    }
+    for (const XpbdSolver& s : nudged)
+      for (size_t i = 0; i < t.particleCount(); ++i)
+        chaos = std::max(chaos, (s.positions()[i] - cpu.positions()[i]).head<3>().norm());
+    EXPECT_LT(worst, f < 3 ? 1e-5f : 5.0f * chaos + 1e-5f) << "frame " << f << ", CPU self-divergence " << chaos;
+  }
+  for (size_t i = hem0; i < t.particleCount(); ++i) {
+    carried = std::max(carried, group->positions()[i].z());
+    carried_without = std::max(carried_without, without->positions()[i].z());
+  }
+  std::printf("[ figures  ] rod through the hem on the device: hem carried %.3f m with the rims, %.3f without\n", carried,
+              carried_without);
+  EXPECT_GT(carried, 0.1f);
+  EXPECT_LT(carried_without, 0.01f);
+}
+
 // The per-phase launches of a batch whose garments differ in substeps, strain-limit passes and
 // stretch-group layout, one of them with the limit off: each garment's limit passes must run in
 // its own last substep only (the host launches them after every substep that ends some garment,

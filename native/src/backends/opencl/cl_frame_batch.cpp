@@ -87,6 +87,7 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
     g.particle_offset = static_cast<uint32_t>(particles);
     g.distance_group_offset = static_cast<uint32_t>(groups);
     g.tether_group_offset = static_cast<uint32_t>(groups + s.distance_groups_ + 1);
+    g.rim_group_offset = static_cast<uint32_t>(groups + s.rim_group_offset_);
     g.pin_offset = static_cast<uint32_t>(pins);
     g.shape_offset = static_cast<uint32_t>(shapes_host_.size());
     g.span_offset = static_cast<uint32_t>(bounds_host_.size() / 2);

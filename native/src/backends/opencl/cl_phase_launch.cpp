@@ -58,7 +58,7 @@ void ClPhasePlan::finish() {
 }
 
 ClPhaseKernels::~ClPhaseKernels() {
-  for (cl_kernel k : {clear_stats_, pin_start_, predict_, pins_, project_, project_rows_, collide_velocity_})
+  for (cl_kernel k : {clear_stats_, pin_start_, predict_, pins_, project_, project_rows_, collide_velocity_, rims_})
     if (k) clReleaseKernel(k);
 }
 
@@ -68,7 +68,7 @@ bool ClPhaseKernels::create(cl_program program, std::string& err) {
       {&clear_stats_, "drape_phase_clear_stats"}, {&pin_start_, "drape_phase_pin_start"},
       {&predict_, "drape_phase_predict"},         {&pins_, "drape_phase_pins"},
       {&project_, "drape_phase_project"},         {&project_rows_, "drape_phase_project_rows"},
-      {&collide_velocity_, "drape_phase_collide_velocity"}};
+      {&collide_velocity_, "drape_phase_collide_velocity"}, {&rims_, "drape_phase_rims"}};
   cl_int rc = CL_SUCCESS;
   for (const auto& k : kernels) {
     *k.first = clCreateKernel(program, k.second, &rc);
@@ -95,7 +95,7 @@ cl_int ClPhaseKernels::enqueue(ClRuntime& runtime, const ClPhaseBuffers& b, cons
     if (rc == CL_SUCCESS) rc = clSetKernelArg(k, i, sizeof(v), &v);
   };
   // The table's common head: table, count, work.
-  for (cl_kernel k : {pin_start_, predict_, pins_, project_, project_rows_, collide_velocity_}) {
+  for (cl_kernel k : {pin_start_, predict_, pins_, project_, project_rows_, collide_velocity_, rims_}) {
     arg(k, 0, b.table);
     arg(k, 1, count);
     arg(k, 2, b.work);
@@ -109,6 +109,8 @@ cl_int ClPhaseKernels::enqueue(ClRuntime& runtime, const ClPhaseBuffers& b, cons
   arg(collide_velocity_, 3, b.x), arg(collide_velocity_, 4, b.prev), arg(collide_velocity_, 5, b.v),
       arg(collide_velocity_, 6, b.span_start), arg(collide_velocity_, 7, b.masks), arg(collide_velocity_, 8, b.shapes),
       arg(collide_velocity_, 9, b.bounds), arg(collide_velocity_, 10, b.stats);
+  arg(rims_, 3, b.x), arg(rims_, 4, b.prev), arg(rims_, 5, b.v), arg(rims_, 6, b.masks), arg(rims_, 7, b.shapes),
+      arg(rims_, 8, b.bounds), arg(rims_, 9, b.constraints), arg(rims_, 10, b.groups), arg(rims_, 11, b.stats);
   // Substeps and passes: up to the largest among the per-phase garments.
   int substeps = 0, iterations = 0;
   const std::vector<uint32_t>& work = plan.work();
@@ -117,6 +119,9 @@ cl_int ClPhaseKernels::enqueue(ClRuntime& runtime, const ClPhaseBuffers& b, cons
     substeps = std::max(substeps, table[g].substeps);
     iterations = std::max(iterations, table[g].iterations);
   }
+  // Whether any per-phase garment collides its rim edges (drape_phase_rims after each collision).
+  bool rims = false;
+  for (size_t g = 0; g < plan.garments(); ++g) rims = rims || (work[g + 1] != work[g] && table[g].rim_groups > 0);
   // One work-item per item, rounded up to 64; or, with `one_group`, a single work-group.
   const size_t wg = runtime.workGroup();
   auto launch = [&](cl_kernel k, size_t items, bool is_last, bool one_group = false) {
@@ -198,7 +203,11 @@ cl_int ClPhaseKernels::enqueue(ClRuntime& runtime, const ClPhaseBuffers& b, cons
       arg(project_rows_, 11, cl_uint{0});
     }
     arg(collide_velocity_, 11, sub);
-    launch(collide_velocity_, plan.items(0), s + 1 == substeps);
+    launch(collide_velocity_, plan.items(0), s + 1 == substeps && !rims);
+    if (rims) {
+      arg(rims_, 12, sub);
+      launch(rims_, wg, s + 1 == substeps, true);
+    }
   }
   return rc;
 }

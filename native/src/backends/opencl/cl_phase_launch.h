@@ -74,7 +74,7 @@ class ClPhaseKernels {
 
  private:
   cl_kernel clear_stats_ = nullptr, pin_start_ = nullptr, predict_ = nullptr, pins_ = nullptr, project_ = nullptr,
-            project_rows_ = nullptr, collide_velocity_ = nullptr;
+            project_rows_ = nullptr, collide_velocity_ = nullptr, rims_ = nullptr;
   // enqueue()'s scratch, kept between frames: the colour groups' launches of a regular pass and
   // of a strain-limit pass.
   std::vector<std::pair<uint32_t, uint32_t>> group_runs_, limit_runs_;

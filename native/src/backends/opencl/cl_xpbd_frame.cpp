@@ -109,6 +109,8 @@ bool ClXpbdSolver::prepareFrame(float dt, int substeps) {
   g.distance_groups = distance_groups_;
   g.tether_group_offset = distance_groups_ + 1;
   g.tether_groups = tether_groups_;
+  g.rim_group_offset = rim_group_offset_;
+  g.rim_groups = params_.collision.rims ? rim_groups_ : 0u;
   g.pin_offset = 0;
   g.pin_count = static_cast<uint32_t>(pin_index_.size());
   g.shape_offset = 0;

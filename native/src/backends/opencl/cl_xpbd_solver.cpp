@@ -63,6 +63,11 @@ std::unique_ptr<ClXpbdSolver> ClXpbdSolver::create(std::shared_ptr<ClRuntime> ru
   s->group_offsets_.push_back(static_cast<uint32_t>(s->constraints_.size()));
   appendGroups(t.tether, true, t.inverse_mass, s->constraints_, s->group_offsets_);
   s->tether_groups_ = static_cast<uint32_t>(s->group_offsets_.size()) - s->distance_groups_ - 2;
+  // The rim edges after the tethers (DrapeClGarment::rim_group_offset): collided, not projected.
+  s->rim_group_offset_ = static_cast<uint32_t>(s->group_offsets_.size());
+  s->group_offsets_.push_back(static_cast<uint32_t>(s->constraints_.size()));
+  appendGroups(t.rims, false, t.inverse_mass, s->constraints_, s->group_offsets_);
+  s->rim_groups_ = static_cast<uint32_t>(s->group_offsets_.size()) - s->rim_group_offset_ - 1;
   std::string perr;
   if (!s->setParams(XpbdParams{}, perr) || !s->allocate(err)) {
     if (err.empty()) err = perr;

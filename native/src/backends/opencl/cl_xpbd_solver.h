@@ -120,6 +120,7 @@ class ClXpbdSolver {
   std::vector<DrapeClConstraint> constraints_;  // distance groups then tether groups (static)
   std::vector<uint32_t> group_offsets_;          // distance groups + 1, then tether groups + 1
   uint32_t distance_groups_ = 0, tether_groups_ = 0;
+  uint32_t rim_group_offset_ = 0, rim_groups_ = 0;  // the rim edges' colours in group_offsets_
   uint32_t kind_end_[2] = {0, 0};  // distance group index where the 1st / 2nd kind ends (DrapeClGarment)
   bool constraints_dirty_ = true;  // not on the device yet
 
