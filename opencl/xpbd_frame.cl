@@ -139,6 +139,7 @@ void DCL_FRAME_BODY(__global const DrapeClGarment* g, DCL_XS float4* x, __global
         const uint begin = groups[g->rim_group_offset + c], end = groups[g->rim_group_offset + c + 1u];
         for (uint k = begin + lid; k < end; k += lsize) {
           const DrapeClConstraint r = constraints[k];
+          if (!(r.w_sum > 0.0f)) continue;  /* gated off (ClXpbdSolver::setRimGate) or both ends pinned */
           float4 pa = x[r.a], pb = x[r.b];
           const uint ma = grouped ? (uint)masks[g->particle_offset + r.a] : 0xFFu;
           const uint mb = grouped ? (uint)masks[g->particle_offset + r.b] : 0xFFu;

@@ -135,12 +135,32 @@ TEST_P(GarmentOpeningsOfTemplates, EveryOpeningRoundItsBodyPartUntilCarriedOff) 
   // Without a body, nothing is counted.
   EXPECT_EQ(g->measure(ctx.restEllipsoids(), nullptr).openings.tracked, 0u);
 
+  // The rim gate's marks (markOn): dressed, the particles of every tracked opening and no others.
+  GarmentOpenings o;
+  std::vector<Vec3> at(g->particleCount());
+  for (size_t i = 0; i < at.size(); ++i) at[i] = g->positions()[i].head<3>();
+  o.bind(g->mesh().indices, at, ctx.restBody());
+  std::vector<uint8_t> on;
+  o.markOn(g->positions(), g->particleCount(), ctx.restBody(), on);
+  ASSERT_EQ(on.size(), g->particleCount());
+  size_t rim_particles = 0;
+  for (const std::vector<uint32_t>& loop : boundaryLoops(g->mesh().indices, g->particleCount()))
+    rim_particles += loop.size();
+  const size_t marked = static_cast<size_t>(std::count(on.begin(), on.end(), uint8_t{1}));
+  EXPECT_GT(marked, 0u);
+  EXPECT_LE(marked, rim_particles);  // only boundary-loop particles
+  if (GetParam().openings == boundaryLoops(g->mesh().indices, g->particleCount()).size())
+    EXPECT_EQ(marked, rim_particles);  // every loop is tracked: all of them
+
   // Carried 1 m sideways, off the body: every opening is off.
   Eigen::Vector4f* x = g->solverFace()->mutableX();
   for (size_t i = 0; i < g->particleCount(); ++i) x[i].x() += 1.0f;
   const GarmentAccuracy carried = g->measure(ctx.restEllipsoids(), nullptr, &ctx.restBody());
   EXPECT_EQ(carried.openings.tracked, GetParam().openings);
   EXPECT_EQ(carried.openings.off, GetParam().openings);
+  // ... and the gate marks nothing.
+  o.markOn(g->positions(), g->particleCount(), ctx.restBody(), on);
+  EXPECT_EQ(std::count(on.begin(), on.end(), uint8_t{1}), 0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Kinds, GarmentOpeningsOfTemplates,

@@ -544,6 +544,17 @@ TEST(OpenClKernels, RimEdgesMatchCpuOnBothDevicePaths) {
   ASSERT_TRUE(phases) << err;
   std::unique_ptr<ClXpbdSolver> without = ClXpbdSolver::create(rt, t, {}, {}, err);
   ASSERT_TRUE(without) << err;
+  // The rim gate on the device (ClXpbdSolver::setRimGate, carried in the rim records): every rim
+  // gated off on both paths is rims off, to the bit.
+  std::unique_ptr<ClXpbdSolver> gated[2] = {ClXpbdSolver::create(rt, t, {}, {}, err),
+                                            ClXpbdSolver::create(rt, t, {}, {}, err)};
+  ASSERT_TRUE(gated[0] && gated[1]) << err;
+  gated[0]->setPath(ClXpbdSolver::Path::WorkGroup);
+  gated[1]->setPath(ClXpbdSolver::Path::Phases);
+  for (auto& s : gated) {
+    ASSERT_TRUE(s->setParams(on, err)) << err;
+    s->setRimGate(std::vector<uint8_t>(t.particleCount(), 0));
+  }
   group->setPath(ClXpbdSolver::Path::WorkGroup);
   phases->setPath(ClXpbdSolver::Path::Phases);
   without->setPath(ClXpbdSolver::Path::WorkGroup);
@@ -564,9 +575,17 @@ TEST(OpenClKernels, RimEdgesMatchCpuOnBothDevicePaths) {
       ASSERT_TRUE(s.setColliderMotion(&collider, &e0, &e1, 1, 0.004f, err));
       ASSERT_TRUE(s.step(1.0f / 30.0f, 10));
     }
-    for (ClXpbdSolver* s : {group.get(), phases.get(), without.get()}) {
+    for (ClXpbdSolver* s : {group.get(), phases.get(), without.get(), gated[0].get(), gated[1].get()}) {
       ASSERT_TRUE(s->setColliderMotion(&e0, &e1, 1, 0.004f, {}, err)) << err;
       ASSERT_TRUE(s->step(1.0f / 30.0f, 10)) << s->lastError();
+    }
+    // The first gated one opens after frame 2, before the rod reaches the hem (frame 6): its
+    // records go up again and it runs as the ungated one from then on, to the bit; the second stays
+    // gated off, as without rims.
+    if (f == 2) gated[0]->setRimGate({});
+    for (size_t i = 0; i < t.particleCount(); ++i) {
+      ASSERT_EQ(gated[0]->positions()[i], group->positions()[i]) << "frame " << f << " particle " << i;
+      ASSERT_EQ(gated[1]->positions()[i], without->positions()[i]) << "frame " << f << " particle " << i;
     }
     EXPECT_FALSE(group->usesPhases());
     EXPECT_TRUE(phases->usesPhases());
@@ -588,6 +607,62 @@ TEST(OpenClKernels, RimEdgesMatchCpuOnBothDevicePaths) {
               carried_without);
   EXPECT_GT(carried, 0.1f);
   EXPECT_LT(carried_without, 0.01f);
+}
+
+// A rim gate that changes between frames reaches a batch (ClFrameBatch re-uploads the member's
+// rim records): three rod scenes of RimEdgesMatchCpuOnBothDevicePaths batched (two in the
+// work-group frame, one per phase) against the same three stepped alone, gated off and then opened
+// after frame 2 (before the rod reaches the hem) or kept off: the same bits every frame.
+TEST(OpenClKernels, RimGateChangesReachABatch) {
+  DRAPE_REQUIRE_OPENCL(rt);
+  test::ClothGrid grid;
+  grid.nx = 12, grid.ny = 6;
+  grid.height = 0.5f;
+  grid.origin = Vec3(-0.5f, 0.0f, 0.0f);
+  TopologyParams tp;
+  for (uint32_t i = 0; i < static_cast<uint32_t>(grid.nx); ++i) tp.pinned.push_back(i);
+  const GarmentTopology t = test::clothGridTopology(grid, tp);
+  const std::vector<uint8_t> closed(t.particleCount(), 0);
+  std::string err;
+  std::vector<std::unique_ptr<ClXpbdSolver>> batched, alone;
+  const ClXpbdSolver::Path paths[3] = {ClXpbdSolver::Path::WorkGroup, ClXpbdSolver::Path::WorkGroup,
+                                       ClXpbdSolver::Path::Phases};
+  for (int g = 0; g < 3; ++g)
+    for (auto* list : {&batched, &alone}) {
+      list->push_back(ClXpbdSolver::create(rt, t, {}, {}, err));
+      ASSERT_TRUE(list->back()) << err;
+      list->back()->setPath(paths[g]);
+      ASSERT_TRUE(list->back()->setParams(XpbdParams{}, err)) << err;
+      list->back()->setRimGate(closed);
+    }
+  ClFrameBatch batch(*rt);
+  std::vector<ClXpbdSolver*> table;
+  for (auto& s : batched) table.push_back(s.get());
+  const float x_mid = -0.5f + 5.5f / static_cast<float>(grid.nx - 1);
+  float carried[3] = {0.0f, 0.0f, 0.0f};
+  for (int f = 0; f < 20; ++f) {
+    if (f == 3)
+      for (int g : {0, 2}) batched[g]->setRimGate({}), alone[g]->setRimGate({});
+    const float z0 = -0.1f + 0.015f * static_cast<float>(f), z1 = z0 + 0.015f;
+    const Ellipsoid e0 = makeEllipsoid(Vec3(x_mid, -0.45f, z0), Vec3(0.01f, 0.2f, 0.01f), 0.0f, Vec3(0, 1, 0));
+    const Ellipsoid e1 = makeEllipsoid(Vec3(x_mid, -0.45f, z1), Vec3(0.01f, 0.2f, 0.01f), 0.0f, Vec3(0, 1, 0));
+    for (int g = 0; g < 3; ++g) {
+      for (ClXpbdSolver* s : {batched[g].get(), alone[g].get()})
+        ASSERT_TRUE(s->setColliderMotion(&e0, &e1, 1, 0.004f, {}, err)) << err;
+      ASSERT_TRUE(batched[g]->prepareFrame(1.0f / 30.0f, 10));
+      ASSERT_TRUE(alone[g]->step(1.0f / 30.0f, 10)) << alone[g]->lastError();
+    }
+    ASSERT_TRUE(batch.run(table, err)) << err;
+    for (int g = 0; g < 3; ++g)
+      for (size_t i = 0; i < t.particleCount(); ++i)
+        ASSERT_EQ(batched[g]->positions()[i], alone[g]->positions()[i]) << "frame " << f << " garment " << g << " particle " << i;
+  }
+  const size_t hem0 = static_cast<size_t>(grid.nx) * static_cast<size_t>(grid.ny - 1);
+  for (int g = 0; g < 3; ++g)
+    for (size_t i = hem0; i < t.particleCount(); ++i) carried[g] = std::max(carried[g], batched[g]->positions()[i].z());
+  EXPECT_GT(carried[0], 0.1f);  // opened: the rod carried the hem
+  EXPECT_GT(carried[2], 0.1f);
+  EXPECT_LT(carried[1], 0.01f);  // kept closed: it went through
 }
 
 // The per-phase launches of a batch whose garments differ in substeps, strain-limit passes and

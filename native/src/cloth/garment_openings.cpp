@@ -115,4 +115,19 @@ OpeningCount GarmentOpenings::count(const Eigen::Vector4f* x, size_t n, const Bo
   return c;
 }
 
+void GarmentOpenings::markOn(const Eigen::Vector4f* x, size_t n, const BodyModel& body, std::vector<uint8_t>& on) const {
+  on.assign(n, 0);
+  if (openings_.empty()) return;
+  const std::vector<std::vector<Vec3>> parts = bodyPolylines(body);
+  std::vector<Vec3> at;
+  for (const Opening& o : openings_) {
+    at.clear();
+    for (uint32_t i : o.loop)
+      if (i < n) at.push_back(x[i].head<3>());
+    if (at.size() != o.loop.size() || o.part >= parts.size()) continue;
+    if (!(loopLinking(at, parts[o.part]) * static_cast<float>(o.sign) >= kOffLinking)) continue;
+    for (uint32_t i : o.loop) on[i] = 1;
+  }
+}
+
 }  // namespace drape

@@ -56,6 +56,11 @@ class GarmentOpenings {
   // The same count for positions now (xyz of x[0 .. n)) on `body` (the same ring layout).
   OpeningCount count(const Eigen::Vector4f* x, size_t n, const BodyModel& body) const;
 
+  // on[i] = 1 for the particles of the openings that go round their body part now (as count():
+  // linking of the same sign at least kOffLinking), 0 for the rest (openings off, boundary loops
+  // not tracked, interior particles). The rim gate (GarmentSim): a rim keeps a limb in, not out.
+  void markOn(const Eigen::Vector4f* x, size_t n, const BodyModel& body, std::vector<uint8_t>& on) const;
+
   // The body-part polylines (spine, arms, legs) of `body`: see the file comment.
   static std::vector<std::vector<Vec3>> bodyPolylines(const BodyModel& body);
 

@@ -115,6 +115,7 @@ struct XpbdFace final : SolverOf<XpbdSolver> {
   bool setParams(const GarmentSimParams& p, std::string& err) override { return s.setParams(p.xpbd, err); }
   void step(float dt, int n) override { s.step(dt, n); }
   double collideMs() const override { return s.lastTimings().collision_ns * 1e-6; }
+  void setRimGate(const std::vector<uint8_t>& on) override { s.setRimGate(on); }
 };
 
 struct MassSpringFace final : SolverOf<MassSpringSolver> {
@@ -599,6 +600,7 @@ void GarmentSim::placeOnBody(const BodyModel& body, const std::vector<Ellipsoid>
   // With a path: skinned onto its first pose (the rest pose where the person stands, which the
   // dressed shape fits), then carried through the others into this one by the ellipsoids.
   const int poses = path_ != nullptr ? path_->poses() : 0;
+  solver_->setRimGate({});  // every rim: the garment is put on the body
   const BodyModel* first = &body;
   const std::vector<Ellipsoid>* first_all = &ellipsoids;
   if (poses > 0) path_->at(0, first, first_all);
@@ -668,6 +670,12 @@ void GarmentSim::step(const BodyModel& body, const std::vector<Ellipsoid>& start
 
 void GarmentSim::runStepFrame(const std::vector<Ellipsoid>& start, const std::vector<Ellipsoid>& end,
                               const std::vector<Vec3>& pins, float dt) {
+  // The rim gate: only the rims of openings round their body part now meet the ellipsoids, so a
+  // rim keeps a limb in but never out (an arm already outside its sleeve caught the cuff from
+  // outside and dragged it: docs/garments.md, "Rim edges"). The frames of a placement or a
+  // restore run with every rim (the garment is dressed, or as it was, then).
+  openings_.markOn(solver_->x(), particleCount(), *pending_body_, rim_gate_);
+  solver_->setRimGate(rim_gate_);
   staging_ = allow_staging_;
   runFrame(start, end, pins, dt);
   staging_ = false;

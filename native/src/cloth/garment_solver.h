@@ -20,6 +20,9 @@ struct GarmentSim::Solver {
   // garments' prepares it and returns true; the caller runs it before reading the state. False
   // (the CPU solvers): step() runs now.
   virtual bool stageStep(float /*dt*/, int /*substeps*/) { return false; }
+  // The rim edges to collide from the next step on (XpbdSolver::setRimGate): one byte per particle,
+  // empty for all. Solvers without rim collision ignore it.
+  virtual void setRimGate(const std::vector<uint8_t>& /*on*/) {}
   virtual bool reset(const std::vector<Vec3>& x, std::string& err) = 0;
   virtual void transform(const Mat3& R, const Vec3& pivot, const Vec3& t, float vscale) = 0;
   virtual const Eigen::Vector4f* x() const = 0;

@@ -618,7 +618,8 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
     CollisionStats cs = collider->collide(x, span_prev ? span_prev : prev, n, p.collision);
     const DistanceConstraints& rims = topology_.rims;
     if (p.collision.rims && rims.size() > 0)
-      collider->collideRims(x, n, rims.a.data(), rims.b.data(), rims.size(), p.collision, cs);
+      collider->collideRims(x, n, rims.a.data(), rims.b.data(), rims.size(), p.collision, cs,
+                            rim_gate_.size() == n ? rim_gate_.data() : nullptr);
     collision_stats_.tests += cs.tests;
     collision_stats_.contacts += cs.contacts;
     collision_stats_.swept_catches += cs.swept_catches;

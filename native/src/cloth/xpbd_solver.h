@@ -92,6 +92,9 @@ class XpbdSolver {
   // constraints with the substep's start positions as `previous`. The caller keeps the collider
   // alive and has set its ellipsoids. nullptr: none. Replaced by setColliderMotion when that is set.
   void setCollider(const EllipsoidCollider* collider) { collider_ = collider; }
+  // Which rim edges the collision tests (EllipsoidCollider::collideRims): those whose two
+  // particles are both on (one byte per particle); empty: all of them. Kept until the next call.
+  void setRimGate(const std::vector<uint8_t>& on) { rim_gate_ = on; }
   // Moving ellipsoids for the following steps: `start` at the step start, `end` at its end,
   // interpolated across the substeps (cloth/collider_motion.h). The solver writes the collider's
   // ellipsoids every substep. count 0 turns it off. Validation as ColliderMotion::set.
@@ -169,6 +172,7 @@ class XpbdSolver {
   void refreshCompliance();  // after setParams
 
   GarmentTopology topology_;
+  std::vector<uint8_t> rim_gate_;  // setRimGate
   XpbdParams params_;
   Batches distance_, tethers_;
   float inv_w_h2_ = -1.0f;  // the 1/h^2 that Batches::inv_w was computed for

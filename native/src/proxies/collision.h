@@ -93,9 +93,11 @@ class EllipsoidCollider {
   // each moved end is collided again (discretely), so no particle is left inside. An edge meets
   // only the ellipsoids both its particles may touch (setGroups). Edges are answered in order,
   // each seeing the ones before it: callers that run them in parallel colour them (no two edges
-  // of a colour share a particle). Returns the edges moved. proxies/collision_rims.cpp.
+  // of a colour share a particle). `active` (one byte per particle, or null: every edge): only
+  // edges whose two particles are both active are tested. Returns the edges moved.
+  // proxies/collision_rims.cpp.
   size_t collideRims(Eigen::Vector4f* positions, size_t count, const uint32_t* a, const uint32_t* b, size_t edges,
-                     const CollisionParams& params, CollisionStats& stats) const;
+                     const CollisionParams& params, CollisionStats& stats, const uint8_t* active = nullptr) const;
 
   // Collision groups. ellipsoid_groups: the groups of each ellipsoid (bits 1 << body chain: one,
   // or two for the shoulder fills, proxies/proxy_builder.h), in the order setEllipsoids receives them; particle_masks: one byte per particle, the

@@ -32,7 +32,7 @@ constexpr float kLimbElongation = 1.5f;
 
 size_t EllipsoidCollider::collideRims(Eigen::Vector4f* positions, size_t count, const uint32_t* a,
                                       const uint32_t* b, size_t edges, const CollisionParams& p,
-                                      CollisionStats& st) const {
+                                      CollisionStats& st, const uint8_t* active) const {
   if (!positions || !a || !b || shapes_.empty()) return 0;
   const bool use_grid = p.broad_phase && grid_;
   const bool grouped = particle_masks_ != nullptr && !allowed_.empty() && groups_.size() == shapes_.size() &&
@@ -41,6 +41,7 @@ size_t EllipsoidCollider::collideRims(Eigen::Vector4f* positions, size_t count, 
   for (size_t e = 0; e < edges; ++e) {
     const uint32_t ia = a[e], ib = b[e];
     if (ia >= count || ib >= count || ia == ib) continue;
+    if (active && !(active[ia] && active[ib])) continue;
     Eigen::Vector4f& pa = positions[ia];
     Eigen::Vector4f& pb = positions[ib];
     const float wa = pa.w() > 0.0f ? pa.w() : 0.0f, wb = pb.w() > 0.0f ? pb.w() : 0.0f;

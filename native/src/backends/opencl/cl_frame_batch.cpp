@@ -153,6 +153,7 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
   if (reallocated || layout != layout_) {
     layout_.clear();  // until the uploads below are queued
     constraints_host_.clear();
+    constraint_versions_.clear();
     groups_host_.clear();
     pin_index_host_.clear();
     masks_host_.clear();
@@ -163,6 +164,7 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
       const uint32_t base = static_cast<uint32_t>(constraints_host_.size());
       for (uint32_t o : s->group_offsets_) groups_host_.push_back(base + o);
       constraints_host_.insert(constraints_host_.end(), s->constraints_.begin(), s->constraints_.end());
+      constraint_versions_.push_back(s->constraints_version_);
       pin_index_host_.insert(pin_index_host_.end(), s->pin_index_.begin(), s->pin_index_.end());
       // As the solver's own buffer: every group for particles without a mask.
       const size_t n = std::min(s->masks_.size(), s->particleCount());
@@ -177,6 +179,18 @@ bool ClFrameBatch::runLocked(const std::vector<ClXpbdSolver*>& solvers, std::str
     write(face_offsets_.mem, 0, normal_tables_.face_offsets.data(), normal_tables_.face_offsets.size() * 4);
     write(vertex_faces_.mem, 0, normal_tables_.vertex_faces.data(), normal_tables_.vertex_faces.size() * 4);
     if (rc == CL_SUCCESS) layout_ = layout;
+  }
+  // A member whose rim gate changed since its constraints went up: its records again (its slice).
+  size_t base = 0;
+  for (size_t i = 0; i < count && i < constraint_versions_.size(); ++i) {
+    const ClXpbdSolver& s = *solvers[i];
+    if (s.constraints_version_ != constraint_versions_[i]) {
+      std::copy(s.constraints_.begin(), s.constraints_.end(), constraints_host_.begin() + static_cast<long>(base));
+      write(constraints_.mem, base * sizeof(DrapeClConstraint), constraints_host_.data() + base,
+            s.constraints_.size() * sizeof(DrapeClConstraint));
+      constraint_versions_[i] = s.constraints_version_;
+    }
+    base += s.constraints_.size();
   }
   write(garments_.mem, 0, table_.data(), count * sizeof(DrapeClGarment));
   write(pin_target_.mem, 0, pin_targets_.data(), pin_targets_.size() * 16);

@@ -69,6 +69,8 @@ class ClFrameBatch {
   std::vector<DclF4> pin_targets_, bounds_host_;
   std::vector<DrapeClShape> shapes_host_;
   std::vector<DrapeClConstraint> constraints_host_;
+  // Each member's constraints_version_ as last uploaded (its rim gate changes its records).
+  std::vector<uint64_t> constraint_versions_;
   std::vector<uint32_t> groups_host_, pin_index_host_;
   std::vector<uint8_t> masks_host_;
   std::vector<DrapeClStats> stats_host_;

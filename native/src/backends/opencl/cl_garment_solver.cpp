@@ -31,6 +31,7 @@ struct ClXpbdFace final : GarmentSim::Solver {
       error = s->lastError();
     }
   }
+  void setRimGate(const std::vector<uint8_t>& on) override { s->setRimGate(on); }
   bool stageStep(float dt, int substeps) override {
     flush();
     staged = s->prepareFrame(dt, substeps);  // false: bad arguments, nothing runs (as step())

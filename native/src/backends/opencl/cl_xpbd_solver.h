@@ -101,6 +101,10 @@ class ClXpbdSolver {
   // on PoCL the phases win from ~7 800 particles, on an H100 from ~1 100-1 300.
   enum class Path { Auto, WorkGroup, Phases };
   void setPath(Path p) { path_ = p; }
+  // The rim gate (XpbdSolver::setRimGate): a rim edge is tested when its two particles are on
+  // (empty: every edge). Carried to the device in the rim records' w_sum (0: off), which the rim
+  // pass does not otherwise read; the records are uploaded again when it changes.
+  void setRimGate(const std::vector<uint8_t>& on);
   bool usesPhases() const {
     return path_ == Path::Phases ||
            (path_ == Path::Auto && particleCount() > runtime_->workGroupMaxParticles());
@@ -123,6 +127,8 @@ class ClXpbdSolver {
   uint32_t rim_group_offset_ = 0, rim_groups_ = 0;  // the rim edges' colours in group_offsets_
   uint32_t kind_end_[2] = {0, 0};  // distance group index where the 1st / 2nd kind ends (DrapeClGarment)
   bool constraints_dirty_ = true;  // not on the device yet
+  uint64_t constraints_version_ = 0;  // counts setRimGate's changes (a batch re-uploads on a new one)
+  std::vector<float> rim_w_;          // each rim record's w_a + w_b (its w_sum while on)
 
   std::vector<Eigen::Vector4f> x_;
   std::vector<cl_event> writes_, runs_, reads_;   // stepDevice scratch (events of one frame)
