@@ -48,6 +48,21 @@ bool dcl_item(__global const uint* work, uint count, uint row, uint* gi, uint* j
  * last one ending with the frame), as the frame kernel's span0 / span counters. */
 int dcl_span_of(int s, int stride) { return s / (stride > 0 ? stride : 1); }
 
+/* Garment g's collision span `span` (its shapes, bounds and contact parameters). */
+CollideSpan dcl_collide_span(__global const DrapeClGarment* g, int span, __global const DrapeClShape* shapes,
+                             __global const float4* span_bounds) {
+  CollideSpan sp;
+  sp.shapes = shapes + g->shape_offset + (uint)span * g->shape_count;
+  sp.count = g->shape_count;
+  sp.flags = g->flags;
+  sp.bound_min = span_bounds[2 * (g->span_offset + (uint)span)].xyz;
+  sp.bound_max = span_bounds[2 * (g->span_offset + (uint)span) + 1].xyz;
+  sp.static_friction = g->static_friction;
+  sp.kinetic_friction = g->kinetic_friction;
+  sp.max_escape = g->max_escape;
+  return sp;
+}
+
 /* The per-phase garments' counters (the others' belong to the frame kernel of the batch). */
 __kernel void drape_phase_clear_stats(__global DrapeClStats* stats, uint count,
                                       __global const uint* work) {
@@ -196,15 +211,7 @@ __kernel void drape_phase_collide_velocity(__global const DrapeClGarment* table,
   const float4 pi = prev[p];
   CollideCounters st = {0u, 0u, 0u, 0u};
   if (collide && g->shape_count > 0u) {
-    CollideSpan sp;
-    sp.shapes = shapes + g->shape_offset + (uint)span * g->shape_count;
-    sp.count = g->shape_count;
-    sp.flags = g->flags;
-    sp.bound_min = span_bounds[2 * (g->span_offset + (uint)span)].xyz;
-    sp.bound_max = span_bounds[2 * (g->span_offset + (uint)span) + 1].xyz;
-    sp.static_friction = g->static_friction;
-    sp.kinetic_friction = g->kinetic_friction;
-    sp.max_escape = g->max_escape;
+    const CollideSpan sp = dcl_collide_span(g, span, shapes, span_bounds);
     const float4 from = stride > 1 ? span_start[p] : pi;
     const uint mask = (g->flags & DRAPE_CL_GROUPED) ? (uint)masks[p] : 0xFFu;
     const float4 y = collide_particle(&sp, mask, xi, from, &st);
@@ -245,15 +252,7 @@ void drape_phase_rims(__global const DrapeClGarment* table, uint count, __global
     const int stride = g->stride;
     const int span = dcl_span_of(substep, stride);
     if (!((substep + 1 - span * stride) >= stride || substep + 1 == g->substeps)) continue;
-    CollideSpan sp;
-    sp.shapes = shapes + g->shape_offset + (uint)span * g->shape_count;
-    sp.count = g->shape_count;
-    sp.flags = g->flags;
-    sp.bound_min = span_bounds[2 * (g->span_offset + (uint)span)].xyz;
-    sp.bound_max = span_bounds[2 * (g->span_offset + (uint)span) + 1].xyz;
-    sp.static_friction = g->static_friction;
-    sp.kinetic_friction = g->kinetic_friction;
-    sp.max_escape = g->max_escape;
+    const CollideSpan sp = dcl_collide_span(g, span, shapes, span_bounds);
     const bool grouped = (g->flags & DRAPE_CL_GROUPED) != 0u;
     const uint o = g->particle_offset;
     CollideCounters st = {0u, 0u, 0u, 0u};

@@ -430,6 +430,32 @@ float maxStretch(const GarmentTopology& t, const Eigen::Vector4f* x) {
   return std::max(0.0f, stretchStats(t, x, scratch).max);
 }
 
+// The CPU run of the device parity tests and its two twins nudged by 1 um at the start (along x,
+// along z): the larger of their distances from it is the CPU's own divergence, the bound's scale.
+struct CpuWithNudges {
+  XpbdSolver cpu, nudged[2];
+  CpuWithNudges(const GarmentTopology& t, const XpbdParams& p) : cpu(t), nudged{XpbdSolver(t), XpbdSolver(t)} {
+    std::string err;
+    EXPECT_TRUE(cpu.setParams(p, err)) << err;
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_TRUE(nudged[k].setParams(p, err)) << err;
+      for (size_t i = 0; i < t.particleCount(); ++i) nudged[k].mutablePositions()[i][k == 0 ? 0 : 2] += 1e-6f;
+    }
+  }
+};
+
+// A device solver of `t` on `path` with `p` (null, with a test failure, when that fails).
+std::unique_ptr<ClXpbdSolver> deviceSolver(const std::shared_ptr<ClRuntime>& rt, const GarmentTopology& t,
+                                           ClXpbdSolver::Path path, const XpbdParams& p) {
+  std::string err;
+  std::unique_ptr<ClXpbdSolver> s = ClXpbdSolver::create(rt, t, {}, {}, err);
+  EXPECT_TRUE(s) << err;
+  if (!s) return s;
+  s->setPath(path);
+  EXPECT_TRUE(s->setParams(p, err)) << err;
+  return s;
+}
+
 // The strain limit on both device paths (one work-group, per-phase launches) against
 // XpbdSolver::step, on the hanging square of frameMatchesXpbdStep with softer stretch edges
 // (so that the cloth the ellipsoid lifts overstretches): the two device paths the same bits; the
@@ -450,25 +476,14 @@ TEST(OpenClKernels, StrainLimitMatchesCpuOnBothDevicePaths) {
   on.strain_limit_passes = 2;
   XpbdParams off = on;
   off.strain_limit = 0.0f;
-  XpbdSolver cpu(t), nudged[2] = {XpbdSolver(t), XpbdSolver(t)};
-  ASSERT_TRUE(cpu.setParams(on, err)) << err;
-  for (int k = 0; k < 2; ++k) {
-    ASSERT_TRUE(nudged[k].setParams(on, err)) << err;
-    for (size_t i = 0; i < t.particleCount(); ++i) nudged[k].mutablePositions()[i][k == 0 ? 0 : 2] += 1e-6f;
-  }
+  CpuWithNudges runs(t, on);
+  XpbdSolver& cpu = runs.cpu;
+  XpbdSolver(&nudged)[2] = runs.nudged;
   // Device: limit on through the work-group frame and the per-phase launches, off (work-group).
-  std::unique_ptr<ClXpbdSolver> group = ClXpbdSolver::create(rt, t, {}, {}, err);
-  ASSERT_TRUE(group) << err;
-  std::unique_ptr<ClXpbdSolver> phases = ClXpbdSolver::create(rt, t, {}, {}, err);
-  ASSERT_TRUE(phases) << err;
-  std::unique_ptr<ClXpbdSolver> unlimited = ClXpbdSolver::create(rt, t, {}, {}, err);
-  ASSERT_TRUE(unlimited) << err;
-  group->setPath(ClXpbdSolver::Path::WorkGroup);
-  phases->setPath(ClXpbdSolver::Path::Phases);
-  unlimited->setPath(ClXpbdSolver::Path::WorkGroup);
-  ASSERT_TRUE(group->setParams(on, err)) << err;
-  ASSERT_TRUE(phases->setParams(on, err)) << err;
-  ASSERT_TRUE(unlimited->setParams(off, err)) << err;
+  std::unique_ptr<ClXpbdSolver> group = deviceSolver(rt, t, ClXpbdSolver::Path::WorkGroup, on);
+  std::unique_ptr<ClXpbdSolver> phases = deviceSolver(rt, t, ClXpbdSolver::Path::Phases, on);
+  std::unique_ptr<ClXpbdSolver> unlimited = deviceSolver(rt, t, ClXpbdSolver::Path::WorkGroup, off);
+  ASSERT_TRUE(group && phases && unlimited);
   EllipsoidCollider collider;
   float chaos = 0.0f, apart = 0.0f, stretch_on = 0.0f, stretch_off = 0.0f;
   for (int f = 0; f < 20; ++f) {
@@ -532,35 +547,18 @@ TEST(OpenClKernels, RimEdgesMatchCpuOnBothDevicePaths) {
   XpbdParams on;
   XpbdParams off = on;
   off.collision.rims = false;
-  XpbdSolver cpu(t), nudged[2] = {XpbdSolver(t), XpbdSolver(t)};
-  ASSERT_TRUE(cpu.setParams(on, err)) << err;
-  for (int k = 0; k < 2; ++k) {
-    ASSERT_TRUE(nudged[k].setParams(on, err)) << err;
-    for (size_t i = 0; i < t.particleCount(); ++i) nudged[k].mutablePositions()[i][k == 0 ? 0 : 2] += 1e-6f;
-  }
-  std::unique_ptr<ClXpbdSolver> group = ClXpbdSolver::create(rt, t, {}, {}, err);
-  ASSERT_TRUE(group) << err;
-  std::unique_ptr<ClXpbdSolver> phases = ClXpbdSolver::create(rt, t, {}, {}, err);
-  ASSERT_TRUE(phases) << err;
-  std::unique_ptr<ClXpbdSolver> without = ClXpbdSolver::create(rt, t, {}, {}, err);
-  ASSERT_TRUE(without) << err;
+  CpuWithNudges runs(t, on);
+  XpbdSolver& cpu = runs.cpu;
+  XpbdSolver(&nudged)[2] = runs.nudged;
+  std::unique_ptr<ClXpbdSolver> group = deviceSolver(rt, t, ClXpbdSolver::Path::WorkGroup, on);
+  std::unique_ptr<ClXpbdSolver> phases = deviceSolver(rt, t, ClXpbdSolver::Path::Phases, on);
+  std::unique_ptr<ClXpbdSolver> without = deviceSolver(rt, t, ClXpbdSolver::Path::WorkGroup, off);
   // The rim gate on the device (ClXpbdSolver::setRimGate, carried in the rim records): every rim
   // gated off on both paths is rims off, to the bit.
-  std::unique_ptr<ClXpbdSolver> gated[2] = {ClXpbdSolver::create(rt, t, {}, {}, err),
-                                            ClXpbdSolver::create(rt, t, {}, {}, err)};
-  ASSERT_TRUE(gated[0] && gated[1]) << err;
-  gated[0]->setPath(ClXpbdSolver::Path::WorkGroup);
-  gated[1]->setPath(ClXpbdSolver::Path::Phases);
-  for (auto& s : gated) {
-    ASSERT_TRUE(s->setParams(on, err)) << err;
-    s->setRimGate(std::vector<uint8_t>(t.particleCount(), 0));
-  }
-  group->setPath(ClXpbdSolver::Path::WorkGroup);
-  phases->setPath(ClXpbdSolver::Path::Phases);
-  without->setPath(ClXpbdSolver::Path::WorkGroup);
-  ASSERT_TRUE(group->setParams(on, err)) << err;
-  ASSERT_TRUE(phases->setParams(on, err)) << err;
-  ASSERT_TRUE(without->setParams(off, err)) << err;
+  std::unique_ptr<ClXpbdSolver> gated[2] = {deviceSolver(rt, t, ClXpbdSolver::Path::WorkGroup, on),
+                                            deviceSolver(rt, t, ClXpbdSolver::Path::Phases, on)};
+  ASSERT_TRUE(group && phases && without && gated[0] && gated[1]);
+  for (auto& s : gated) s->setRimGate(std::vector<uint8_t>(t.particleCount(), 0));
   EllipsoidCollider collider;
   const float x_mid = -0.5f + 5.5f / static_cast<float>(grid.nx - 1);
   const size_t hem0 = static_cast<size_t>(grid.nx) * static_cast<size_t>(grid.ny - 1);

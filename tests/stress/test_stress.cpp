@@ -191,7 +191,15 @@ TEST(StressBones, ZeroLengthAndReversedBones) {
   STRESS_REQUIRE_TAKE(take, kComeHere);
   const double end = kStart + 1.0;
   const std::vector<double> times = fixedTimes(replayedSeconds(take, end + 2.0), 1.0 / 30.0);
-  const Series control = replay(take, times);
+  // 400 particles under the sanitizers (1 000 in release, as before): the 200-particle T-shirt has
+  // an opening off in every measured frame of the recovery window undisturbed (its arms out of its
+  // sleeves from the first frame), so there the scenario could not ask whether the garment is back
+  // on the body;
+  // and since the rims are collided (docs/collision.md, "Rim edges") its median P99 one second after
+  // the zero-length upper arms came 0.0009 over the bound under ASan (0.1687 against 0.108 + 0.06),
+  // with or without the gate. At 400: 0.113 against 0.110, no opening off (ASan).
+  const Dressing dressing = clothDressing();
+  const Series control = replay(take, times, nullptr, dressing);
   auto reflect = [](drape_joint& child, const drape_joint& parent) {
     child.position = drape_vec3{2 * parent.position.x - child.position.x, 2 * parent.position.y - child.position.y,
                                 2 * parent.position.z - child.position.z};
@@ -220,7 +228,7 @@ TEST(StressBones, ZeroLengthAndReversedBones) {
   for (const Case& c : variants(cases, {0, 2, 4})) {
     const Series s = replay(take, times, [&](double t, Joints& j) {
       if (t >= kStart && t < end) c.f(j);
-    });
+    }, dressing);
     print(c.name, s);
     expectHealthy(s, c.name);
     expectRecovered(s, control, end, c.name, 1.0, c.median_margin, 0.12f, c.stays_on);

@@ -98,10 +98,9 @@ void GarmentOpenings::bind(const std::vector<uint32_t>& triangles, const std::ve
   }
 }
 
-OpeningCount GarmentOpenings::count(const Eigen::Vector4f* x, size_t n, const BodyModel& body) const {
-  OpeningCount c;
-  c.tracked = static_cast<uint32_t>(openings_.size());
-  if (openings_.empty()) return c;
+template <class F>
+void GarmentOpenings::forEachOn(const Eigen::Vector4f* x, size_t n, const BodyModel& body, F&& f) const {
+  if (openings_.empty()) return;
   const std::vector<std::vector<Vec3>> parts = bodyPolylines(body);
   std::vector<Vec3> at;
   for (const Opening& o : openings_) {
@@ -110,24 +109,25 @@ OpeningCount GarmentOpenings::count(const Eigen::Vector4f* x, size_t n, const Bo
       if (i < n) at.push_back(x[i].head<3>());
     const bool whole = at.size() == o.loop.size() && o.part < parts.size();
     const float linking = whole ? loopLinking(at, parts[o.part]) : 0.0f;
-    if (!(linking * static_cast<float>(o.sign) >= kOffLinking)) ++c.off;
+    f(o, linking * static_cast<float>(o.sign) >= kOffLinking);
   }
+}
+
+OpeningCount GarmentOpenings::count(const Eigen::Vector4f* x, size_t n, const BodyModel& body) const {
+  OpeningCount c;
+  c.tracked = static_cast<uint32_t>(openings_.size());
+  forEachOn(x, n, body, [&](const Opening&, bool on) {
+    if (!on) ++c.off;
+  });
   return c;
 }
 
 void GarmentOpenings::markOn(const Eigen::Vector4f* x, size_t n, const BodyModel& body, std::vector<uint8_t>& on) const {
   on.assign(n, 0);
-  if (openings_.empty()) return;
-  const std::vector<std::vector<Vec3>> parts = bodyPolylines(body);
-  std::vector<Vec3> at;
-  for (const Opening& o : openings_) {
-    at.clear();
-    for (uint32_t i : o.loop)
-      if (i < n) at.push_back(x[i].head<3>());
-    if (at.size() != o.loop.size() || o.part >= parts.size()) continue;
-    if (!(loopLinking(at, parts[o.part]) * static_cast<float>(o.sign) >= kOffLinking)) continue;
-    for (uint32_t i : o.loop) on[i] = 1;
-  }
+  forEachOn(x, n, body, [&](const Opening& o, bool is_on) {
+    if (is_on)
+      for (uint32_t i : o.loop) on[i] = 1;
+  });
 }
 
 }  // namespace drape

@@ -71,6 +71,9 @@ class GarmentOpenings {
     int sign;                    // of the linking at rest
   };
   std::vector<Opening> openings_;  // the tracked ones only
+  // f(opening, on) for every tracked opening, on = round its body part now (count's test).
+  template <class F>
+  void forEachOn(const Eigen::Vector4f* x, size_t n, const BodyModel& body, F&& f) const;
 };
 
 }  // namespace drape
