@@ -135,7 +135,8 @@ TEST_P(GarmentOpeningsOfTemplates, EveryOpeningRoundItsBodyPartUntilCarriedOff) 
   // Without a body, nothing is counted.
   EXPECT_EQ(g->measure(ctx.restEllipsoids(), nullptr).openings.tracked, 0u);
 
-  // The rim gate's marks (markOn): dressed, the particles of every tracked opening and no others.
+  // The rim gate's marks (markOn): dressed, the particles of the openings round a limb (sleeves,
+  // armholes, trouser legs; not the hem, collar or waist round the spine) and no others.
   GarmentOpenings o;
   std::vector<Vec3> at(g->particleCount());
   for (size_t i = 0; i < at.size(); ++i) at[i] = g->positions()[i].head<3>();
@@ -147,10 +148,10 @@ TEST_P(GarmentOpeningsOfTemplates, EveryOpeningRoundItsBodyPartUntilCarriedOff) 
   for (const std::vector<uint32_t>& loop : boundaryLoops(g->mesh().indices, g->particleCount()))
     rim_particles += loop.size();
   const size_t marked = static_cast<size_t>(std::count(on.begin(), on.end(), uint8_t{1}));
+  // Some (a skirt's hem goes round a leg most, its waist round the spine), never all: every kind
+  // has a loop round the spine (hem, collar or waist).
   EXPECT_GT(marked, 0u);
-  EXPECT_LE(marked, rim_particles);  // only boundary-loop particles
-  if (GetParam().openings == boundaryLoops(g->mesh().indices, g->particleCount()).size())
-    EXPECT_EQ(marked, rim_particles);  // every loop is tracked: all of them
+  EXPECT_LT(marked, rim_particles);
 
   // Carried 1 m sideways, off the body: every opening is off.
   Eigen::Vector4f* x = g->solverFace()->mutableX();

@@ -99,11 +99,13 @@ void GarmentOpenings::bind(const std::vector<uint32_t>& triangles, const std::ve
 }
 
 template <class F>
-void GarmentOpenings::forEachOn(const Eigen::Vector4f* x, size_t n, const BodyModel& body, F&& f) const {
+void GarmentOpenings::forEachOn(const Eigen::Vector4f* x, size_t n, const BodyModel& body, F&& f,
+                                bool limbs_only) const {
   if (openings_.empty()) return;
   const std::vector<std::vector<Vec3>> parts = bodyPolylines(body);
   std::vector<Vec3> at;
   for (const Opening& o : openings_) {
+    if (limbs_only && o.part == 0) continue;  // bodyPolylines' first: the spine
     at.clear();
     for (uint32_t i : o.loop)
       if (i < n) at.push_back(x[i].head<3>());
@@ -127,7 +129,7 @@ void GarmentOpenings::markOn(const Eigen::Vector4f* x, size_t n, const BodyModel
   forEachOn(x, n, body, [&](const Opening& o, bool is_on) {
     if (is_on)
       for (uint32_t i : o.loop) on[i] = 1;
-  });
+  }, /*limbs_only=*/true);
 }
 
 }  // namespace drape

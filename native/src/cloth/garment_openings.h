@@ -56,9 +56,11 @@ class GarmentOpenings {
   // The same count for positions now (xyz of x[0 .. n)) on `body` (the same ring layout).
   OpeningCount count(const Eigen::Vector4f* x, size_t n, const BodyModel& body) const;
 
-  // on[i] = 1 for the particles of the openings that go round their body part now (as count():
-  // linking of the same sign at least kOffLinking), 0 for the rest (openings off, boundary loops
-  // not tracked, interior particles). The rim gate (GarmentSim): a rim keeps a limb in, not out.
+  // on[i] = 1 for the particles of the openings round a limb (an arm or a leg) that go round it now
+  // (as count(): linking of the same sign at least kOffLinking), 0 for the rest (openings off, the
+  // spine's openings, loops not tracked, interior particles). The rim gate (GarmentSim): a rim keeps
+  // a limb in, not out; only a limb is thin enough to slip between two rim particles, and the
+  // spine's hem and collar are the largest loops to test (docs/collision.md, "Rim edges").
   void markOn(const Eigen::Vector4f* x, size_t n, const BodyModel& body, std::vector<uint8_t>& on) const;
 
   // The body-part polylines (spine, arms, legs) of `body`: see the file comment.
@@ -71,9 +73,10 @@ class GarmentOpenings {
     int sign;                    // of the linking at rest
   };
   std::vector<Opening> openings_;  // the tracked ones only
-  // f(opening, on) for every tracked opening, on = round its body part now (count's test).
+  // f(opening, on) for every tracked opening (limbs_only: those round an arm or a leg), on = round
+  // its body part now (count's test).
   template <class F>
-  void forEachOn(const Eigen::Vector4f* x, size_t n, const BodyModel& body, F&& f) const;
+  void forEachOn(const Eigen::Vector4f* x, size_t n, const BodyModel& body, F&& f, bool limbs_only = false) const;
 };
 
 }  // namespace drape

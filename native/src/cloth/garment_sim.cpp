@@ -601,6 +601,7 @@ void GarmentSim::placeOnBody(const BodyModel& body, const std::vector<Ellipsoid>
   // dressed shape fits), then carried through the others into this one by the ellipsoids.
   const int poses = path_ != nullptr ? path_->poses() : 0;
   solver_->setRimGate({});  // every rim: the garment is put on the body
+  rim_gate_stale_ = true;
   const BodyModel* first = &body;
   const std::vector<Ellipsoid>* first_all = &ellipsoids;
   if (poses > 0) path_->at(0, first, first_all);
@@ -674,7 +675,12 @@ void GarmentSim::runStepFrame(const std::vector<Ellipsoid>& start, const std::ve
   // rim keeps a limb in but never out (an arm already outside its sleeve caught the cuff from
   // outside and dragged it: docs/garments.md, "Rim edges"). The frames of a placement or a
   // restore run with every rim (the garment is dressed, or as it was, then).
-  openings_.markOn(solver_->x(), particleCount(), *pending_body_, rim_gate_);
+  // Every kRimGateEverySteps steps (its linking costs ~0.2 ms a step at 2 000 particles; an
+  // opening comes off over several frames, the gate follows it within a few).
+  if (steps_ % kRimGateEverySteps == 0 || rim_gate_stale_ || rim_gate_.size() != particleCount()) {
+    openings_.markOn(solver_->x(), particleCount(), *pending_body_, rim_gate_);
+    rim_gate_stale_ = false;
+  }
   solver_->setRimGate(rim_gate_);
   staging_ = allow_staging_;
   runFrame(start, end, pins, dt);
