@@ -109,7 +109,6 @@ bool GarmentSim::restoreState(KeptState& k, const BodyModel& body, const RingPos
   catch_b_.resize(end.size());
   catch_pins_.resize(pins_.size());
   solver_->setRimGate({});  // every rim: the garment as it was, on the body
-  rim_gate_stale_ = true;
   for (int f = 0; f < kCatchUpFrames; ++f) {
     const float t0 = static_cast<float>(f) / kCatchUpFrames, t1 = static_cast<float>(f + 1) / kCatchUpFrames;
     for (size_t i = 0; i < end.size(); ++i) {
