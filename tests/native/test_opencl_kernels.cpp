@@ -527,6 +527,28 @@ TEST(OpenClKernels, StrainLimitMatchesCpuOnBothDevicePaths) {
   EXPECT_LT(stretch_on, stretch_off - 0.03f);  // and the limit took much of it out
 }
 
+// The rim tests' scene: a 1 m x 0.5 m sheet of 12 x 6 particles hanging from its pinned top row,
+// and a thin upright rod (2 cm thick) at depth z, between hem particles 5 and 6 (9 cm apart).
+struct RodScene {
+  GarmentTopology sheet;
+  size_t hem0 = 0;  // the hem's first particle
+  float x_mid = 0.0f;
+  RodScene() {
+    test::ClothGrid grid;
+    grid.nx = 12, grid.ny = 6;
+    grid.height = 0.5f;
+    grid.origin = Vec3(-0.5f, 0.0f, 0.0f);
+    TopologyParams tp;
+    for (uint32_t i = 0; i < static_cast<uint32_t>(grid.nx); ++i) tp.pinned.push_back(i);
+    sheet = test::clothGridTopology(grid, tp);
+    hem0 = static_cast<size_t>(grid.nx) * static_cast<size_t>(grid.ny - 1);
+    x_mid = -0.5f + 5.5f / static_cast<float>(grid.nx - 1);
+  }
+  Ellipsoid rod(float z) const {
+    return makeEllipsoid(Vec3(x_mid, -0.45f, z), Vec3(0.01f, 0.2f, 0.01f), 0.0f, Vec3(0, 1, 0));
+  }
+};
+
 // The rim edges (EllipsoidCollider::collideRims) on both device paths against XpbdSolver::step:
 // a sheet hanging from its top row and a thin upright rod moving through its hem between two hem
 // particles (the scene of CollideRims.AThinRodCatchesTheHemInsteadOfPassingThroughTheCloth), which
@@ -535,13 +557,8 @@ TEST(OpenClKernels, StrainLimitMatchesCpuOnBothDevicePaths) {
 // and left behind without.
 TEST(OpenClKernels, RimEdgesMatchCpuOnBothDevicePaths) {
   DRAPE_REQUIRE_OPENCL(rt);
-  test::ClothGrid grid;
-  grid.nx = 12, grid.ny = 6;
-  grid.height = 0.5f;
-  grid.origin = Vec3(-0.5f, 0.0f, 0.0f);
-  TopologyParams tp;
-  for (uint32_t i = 0; i < static_cast<uint32_t>(grid.nx); ++i) tp.pinned.push_back(i);
-  const GarmentTopology t = test::clothGridTopology(grid, tp);
+  const RodScene scene;
+  const GarmentTopology& t = scene.sheet;
   ASSERT_GT(t.rims.size(), 0u);
   std::string err;
   XpbdParams on;
@@ -560,13 +577,10 @@ TEST(OpenClKernels, RimEdgesMatchCpuOnBothDevicePaths) {
   ASSERT_TRUE(group && phases && without && gated[0] && gated[1]);
   for (auto& s : gated) s->setRimGate(std::vector<uint8_t>(t.particleCount(), 0));
   EllipsoidCollider collider;
-  const float x_mid = -0.5f + 5.5f / static_cast<float>(grid.nx - 1);
-  const size_t hem0 = static_cast<size_t>(grid.nx) * static_cast<size_t>(grid.ny - 1);
   float chaos = 0.0f, carried = 0.0f, carried_without = 0.0f;
   for (int f = 0; f < 20; ++f) {
     const float z0 = -0.1f + 0.015f * static_cast<float>(f), z1 = z0 + 0.015f;
-    const Ellipsoid e0 = makeEllipsoid(Vec3(x_mid, -0.45f, z0), Vec3(0.01f, 0.2f, 0.01f), 0.0f, Vec3(0, 1, 0));
-    const Ellipsoid e1 = makeEllipsoid(Vec3(x_mid, -0.45f, z1), Vec3(0.01f, 0.2f, 0.01f), 0.0f, Vec3(0, 1, 0));
+    const Ellipsoid e0 = scene.rod(z0), e1 = scene.rod(z1);
     ASSERT_TRUE(cpu.setColliderMotion(&collider, &e0, &e1, 1, 0.004f, err));
     ASSERT_TRUE(cpu.step(1.0f / 30.0f, 10));
     for (XpbdSolver& s : nudged) {
@@ -597,7 +611,7 @@ TEST(OpenClKernels, RimEdgesMatchCpuOnBothDevicePaths) {
         chaos = std::max(chaos, (s.positions()[i] - cpu.positions()[i]).head<3>().norm());
     EXPECT_LT(worst, f < 3 ? 1e-5f : 5.0f * chaos + 1e-5f) << "frame " << f << ", CPU self-divergence " << chaos;
   }
-  for (size_t i = hem0; i < t.particleCount(); ++i) {
+  for (size_t i = scene.hem0; i < t.particleCount(); ++i) {
     carried = std::max(carried, group->positions()[i].z());
     carried_without = std::max(carried_without, without->positions()[i].z());
   }
@@ -613,13 +627,8 @@ TEST(OpenClKernels, RimEdgesMatchCpuOnBothDevicePaths) {
 // after frame 2 (before the rod reaches the hem) or kept off: the same bits every frame.
 TEST(OpenClKernels, RimGateChangesReachABatch) {
   DRAPE_REQUIRE_OPENCL(rt);
-  test::ClothGrid grid;
-  grid.nx = 12, grid.ny = 6;
-  grid.height = 0.5f;
-  grid.origin = Vec3(-0.5f, 0.0f, 0.0f);
-  TopologyParams tp;
-  for (uint32_t i = 0; i < static_cast<uint32_t>(grid.nx); ++i) tp.pinned.push_back(i);
-  const GarmentTopology t = test::clothGridTopology(grid, tp);
+  const RodScene scene;
+  const GarmentTopology& t = scene.sheet;
   const std::vector<uint8_t> closed(t.particleCount(), 0);
   std::string err;
   std::vector<std::unique_ptr<ClXpbdSolver>> batched, alone;
@@ -636,14 +645,12 @@ TEST(OpenClKernels, RimGateChangesReachABatch) {
   ClFrameBatch batch(*rt);
   std::vector<ClXpbdSolver*> table;
   for (auto& s : batched) table.push_back(s.get());
-  const float x_mid = -0.5f + 5.5f / static_cast<float>(grid.nx - 1);
   float carried[3] = {0.0f, 0.0f, 0.0f};
   for (int f = 0; f < 20; ++f) {
     if (f == 3)
       for (int g : {0, 2}) batched[g]->setRimGate({}), alone[g]->setRimGate({});
     const float z0 = -0.1f + 0.015f * static_cast<float>(f), z1 = z0 + 0.015f;
-    const Ellipsoid e0 = makeEllipsoid(Vec3(x_mid, -0.45f, z0), Vec3(0.01f, 0.2f, 0.01f), 0.0f, Vec3(0, 1, 0));
-    const Ellipsoid e1 = makeEllipsoid(Vec3(x_mid, -0.45f, z1), Vec3(0.01f, 0.2f, 0.01f), 0.0f, Vec3(0, 1, 0));
+    const Ellipsoid e0 = scene.rod(z0), e1 = scene.rod(z1);
     for (int g = 0; g < 3; ++g) {
       for (ClXpbdSolver* s : {batched[g].get(), alone[g].get()})
         ASSERT_TRUE(s->setColliderMotion(&e0, &e1, 1, 0.004f, {}, err)) << err;
@@ -655,9 +662,8 @@ TEST(OpenClKernels, RimGateChangesReachABatch) {
       for (size_t i = 0; i < t.particleCount(); ++i)
         ASSERT_EQ(batched[g]->positions()[i], alone[g]->positions()[i]) << "frame " << f << " garment " << g << " particle " << i;
   }
-  const size_t hem0 = static_cast<size_t>(grid.nx) * static_cast<size_t>(grid.ny - 1);
   for (int g = 0; g < 3; ++g)
-    for (size_t i = hem0; i < t.particleCount(); ++i) carried[g] = std::max(carried[g], batched[g]->positions()[i].z());
+    for (size_t i = scene.hem0; i < t.particleCount(); ++i) carried[g] = std::max(carried[g], batched[g]->positions()[i].z());
   EXPECT_GT(carried[0], 0.1f);  // opened: the rod carried the hem
   EXPECT_GT(carried[2], 0.1f);
   EXPECT_LT(carried[1], 0.01f);  // kept closed: it went through

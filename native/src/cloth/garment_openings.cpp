@@ -48,11 +48,18 @@ float loopLinking(const std::vector<Vec3>& loop, const std::vector<Vec3>& polyli
 
 std::vector<std::vector<Vec3>> GarmentOpenings::bodyPolylines(const BodyModel& body) {
   std::vector<std::vector<Vec3>> out;
+  bodyPolylines(body, out);
+  return out;
+}
+
+void GarmentOpenings::bodyPolylines(const BodyModel& body, std::vector<std::vector<Vec3>>& out) {
   auto centres = [&](Chain c, std::vector<Vec3>& into) {
     const int first = body.chainFirstRing(c), count = body.chainRingCount(c);
     for (int i = 0; i < count; ++i) into.push_back(body.rings()[static_cast<size_t>(first + i)].centre);
   };
-  std::vector<Vec3> spine;
+  out.resize(5);  // spine, then ArmL, ArmR, LegL, LegR; the vectors keep their capacity
+  std::vector<Vec3>& spine = out[0];
+  spine.clear();
   centres(Chain::Torso, spine);
   if (spine.size() >= 2) {
     const Vec3 down = spine[0] - spine[1];
@@ -60,9 +67,10 @@ std::vector<std::vector<Vec3>> GarmentOpenings::bodyPolylines(const BodyModel& b
   }
   centres(Chain::Head, spine);
   spine.push_back(body.apex(Chain::Head));
-  out.push_back(std::move(spine));
+  size_t p = 1;
   for (Chain c : {Chain::ArmL, Chain::ArmR, Chain::LegL, Chain::LegR}) {
-    std::vector<Vec3> limb;
+    std::vector<Vec3>& limb = out[p++];
+    limb.clear();
     centres(c, limb);
     // A leg starts kLegExtensionM above its thigh ring, in the pelvis.
     const bool leg = c == Chain::LegL || c == Chain::LegR;
@@ -71,9 +79,7 @@ std::vector<std::vector<Vec3>> GarmentOpenings::bodyPolylines(const BodyModel& b
       if (up.norm() > 1e-6f) limb.insert(limb.begin(), limb[0] + up.normalized() * kLegExtensionM);
     }
     limb.push_back(body.apex(c));
-    out.push_back(std::move(limb));
   }
-  return out;
 }
 
 void GarmentOpenings::bind(const std::vector<uint32_t>& triangles, const std::vector<Vec3>& positions,
@@ -102,8 +108,10 @@ template <class F>
 void GarmentOpenings::forEachOn(const Eigen::Vector4f* x, size_t n, const BodyModel& body, F&& f,
                                 bool limbs_only) const {
   if (openings_.empty()) return;
-  const std::vector<std::vector<Vec3>> parts = bodyPolylines(body);
-  std::vector<Vec3> at;
+  // Scratch kept between calls: the rim gate runs this every step (GarmentSim::runStepFrame).
+  std::vector<std::vector<Vec3>>& parts = parts_scratch_;
+  std::vector<Vec3>& at = loop_scratch_;
+  bodyPolylines(body, parts);
   for (const Opening& o : openings_) {
     if (limbs_only && o.part == 0) continue;  // bodyPolylines' first: the spine
     at.clear();

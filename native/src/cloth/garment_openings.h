@@ -65,6 +65,8 @@ class GarmentOpenings {
 
   // The body-part polylines (spine, arms, legs) of `body`: see the file comment.
   static std::vector<std::vector<Vec3>> bodyPolylines(const BodyModel& body);
+  // The same into `out`, reusing its vectors' storage.
+  static void bodyPolylines(const BodyModel& body, std::vector<std::vector<Vec3>>& out);
 
  private:
   struct Opening {
@@ -73,6 +75,8 @@ class GarmentOpenings {
     int sign;                    // of the linking at rest
   };
   std::vector<Opening> openings_;  // the tracked ones only
+  mutable std::vector<std::vector<Vec3>> parts_scratch_;  // forEachOn's, kept between calls
+  mutable std::vector<Vec3> loop_scratch_;
   // f(opening, on) for every tracked opening (limbs_only: those round an arm or a leg), on = round
   // its body part now (count's test).
   template <class F>

@@ -68,8 +68,6 @@ std::unique_ptr<ClXpbdSolver> ClXpbdSolver::create(std::shared_ptr<ClRuntime> ru
   s->group_offsets_.push_back(static_cast<uint32_t>(s->constraints_.size()));
   appendGroups(t.rims, false, t.inverse_mass, s->constraints_, s->group_offsets_);
   s->rim_groups_ = static_cast<uint32_t>(s->group_offsets_.size()) - s->rim_group_offset_ - 1;
-  for (size_t k = s->group_offsets_[s->rim_group_offset_]; k < s->constraints_.size(); ++k)
-    s->rim_w_.push_back(s->constraints_[k].w_sum);
   std::string perr;
   if (!s->setParams(XpbdParams{}, perr) || !s->allocate(err)) {
     if (err.empty()) err = perr;
@@ -344,12 +342,13 @@ const Eigen::Vector4f* ClXpbdSolver::velocities() const {
 
 
 void ClXpbdSolver::setRimGate(const std::vector<uint8_t>& on) {
-  const size_t first = group_offsets_[rim_group_offset_], n = particleCount();
+  const size_t n = particleCount();
+  const std::vector<float>& inv_mass = topology_.inverse_mass;
   bool changed = false;
-  for (size_t k = 0; k < rim_w_.size(); ++k) {
-    DrapeClConstraint& c = constraints_[first + k];
+  for (size_t k = group_offsets_[rim_group_offset_]; k < constraints_.size(); ++k) {
+    DrapeClConstraint& c = constraints_[k];
     const bool open = on.size() != n || (on[c.a] && on[c.b]);
-    const float w = open ? rim_w_[k] : 0.0f;
+    const float w = open ? inv_mass[c.a] + inv_mass[c.b] : 0.0f;  // appendGroups' w_sum while open
     if (c.w_sum == w) continue;
     c.w_sum = w;
     changed = true;

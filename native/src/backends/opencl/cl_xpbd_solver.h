@@ -121,14 +121,13 @@ class ClXpbdSolver {
   GarmentTopology topology_;
   XpbdParams params_;
   std::vector<uint8_t> masks_, groups_;
-  std::vector<DrapeClConstraint> constraints_;  // distance groups then tether groups (static)
-  std::vector<uint32_t> group_offsets_;          // distance groups + 1, then tether groups + 1
+  std::vector<DrapeClConstraint> constraints_;  // distance groups, tether groups, then the rims
+  std::vector<uint32_t> group_offsets_;          // distance groups + 1, tether groups + 1, rim groups + 1
   uint32_t distance_groups_ = 0, tether_groups_ = 0;
   uint32_t rim_group_offset_ = 0, rim_groups_ = 0;  // the rim edges' colours in group_offsets_
   uint32_t kind_end_[2] = {0, 0};  // distance group index where the 1st / 2nd kind ends (DrapeClGarment)
   bool constraints_dirty_ = true;  // not on the device yet
   uint64_t constraints_version_ = 0;  // counts setRimGate's changes (a batch re-uploads on a new one)
-  std::vector<float> rim_w_;          // each rim record's w_a + w_b (its w_sum while on)
 
   std::vector<Eigen::Vector4f> x_;
   std::vector<cl_event> writes_, runs_, reads_;   // stepDevice scratch (events of one frame)
