@@ -77,6 +77,73 @@ TEST(GarmentOpeningsGeometry, LinkingOfALoopAndALine) {
   EXPECT_EQ(loopLinking(loop, {Vec3::Zero()}), 0.0f);
 }
 
+// The reference: Gauss's integral as the sum over every loop edge and polyline segment of the
+// signed solid angle one subtends seen along the other (Klenin & Langowski 2000, eq. 15-16),
+// what loopLinking computed before it went over a fan.
+double segmentLinkingReference(const Vec3& p1f, const Vec3& p2f, const Vec3& p3f, const Vec3& p4f) {
+  const Eigen::Vector3d p1 = p1f.cast<double>(), p2 = p2f.cast<double>(), p3 = p3f.cast<double>(),
+                        p4 = p4f.cast<double>();
+  const Eigen::Vector3d r13 = p3 - p1, r14 = p4 - p1, r23 = p3 - p2, r24 = p4 - p2, r12 = p2 - p1, r34 = p4 - p3;
+  const Eigen::Vector3d c[4] = {r13.cross(r14), r14.cross(r24), r24.cross(r23), r23.cross(r13)};
+  Eigen::Vector3d u[4];
+  for (int i = 0; i < 4; ++i) {
+    if (c[i].norm() <= 1e-15) return 0.0;
+    u[i] = c[i].normalized();
+  }
+  double omega = 0.0;
+  for (int i = 0; i < 4; ++i) omega += std::asin(std::clamp(u[i].dot(u[(i + 1) % 4]), -1.0, 1.0));
+  const double side = r34.cross(r12).dot(r13);
+  return (side > 0.0 ? omega : side < 0.0 ? -omega : 0.0) / (4.0 * static_cast<double>(kPi));
+}
+
+double loopLinkingReference(const std::vector<Vec3>& loop, const std::vector<Vec3>& polyline) {
+  double sum = 0.0;
+  for (size_t k = 0; k < loop.size(); ++k)
+    for (size_t s = 0; s + 1 < polyline.size(); ++s)
+      sum += segmentLinkingReference(loop[k], loop[(k + 1) % loop.size()], polyline[s], polyline[s + 1]);
+  return sum;
+}
+
+// Crumpled, non-planar loops (a hem, a cuff) and bent polylines (a limb's ring centres), through
+// them, ending in them, beside them, and with their ends in the loop's plane: the fan's count of
+// crossings and its solid angles give the pairwise sum's value.
+TEST(GarmentOpeningsGeometry, FanLinkingEqualsThePairwiseSum) {
+  uint32_t seed = 12345u;
+  auto uniform = [&](float lo, float hi) {
+    seed = seed * 1664525u + 1013904223u;
+    return lo + (hi - lo) * static_cast<float>(seed >> 8) / 16777216.0f;
+  };
+  int through = 0, partial = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const int n = 3 + trial % 40;
+    const float r = uniform(0.03f, 0.3f);
+    std::vector<Vec3> loop;
+    for (int k = 0; k < n; ++k) {
+      const float a = 2.0f * kPi * static_cast<float>(k) / static_cast<float>(n) + uniform(-0.5f, 0.5f) / static_cast<float>(n);
+      const float rk = r * uniform(0.6f, 1.4f);
+      loop.emplace_back(rk * std::cos(a), rk * std::sin(a), uniform(-0.5f, 0.5f) * r);
+    }
+    std::vector<Vec3> line;
+    const int segments = 1 + trial % 9;
+    Vec3 p(uniform(-0.5f, 0.5f) * r, uniform(-0.5f, 0.5f) * r, uniform(-1.0f, 0.0f));
+    if (trial % 5 == 4) p.x() += 2.0f * r;  // beside the loop
+    line.push_back(p);
+    const float z_end = trial % 7 == 3 ? 0.0f : uniform(-0.5f, 1.0f);  // % 7 == 3: ends in the loop's plane z = 0
+    for (int s = 1; s <= segments; ++s) {
+      const float t = static_cast<float>(s) / static_cast<float>(segments);
+      line.emplace_back(p.x() + uniform(-0.2f, 0.2f) * r, p.y() + uniform(-0.2f, 0.2f) * r, p.z() + t * (z_end - p.z()));
+    }
+    if (trial % 7 == 3) line.back().z() = 0.0f;
+    const double reference = loopLinkingReference(loop, line);
+    EXPECT_NEAR(loopLinking(loop, line), reference, 1e-5) << "trial " << trial;
+    if (std::fabs(reference) > 0.9) ++through;
+    if (std::fabs(reference) > 0.1 && std::fabs(reference) < 0.9) ++partial;
+  }
+  // The draw covers both kinds: polylines through the loop and polylines ending inside it.
+  EXPECT_GT(through, 50);
+  EXPECT_GT(partial, 50);
+}
+
 // A loop of n points in the plane of `ring` (its frame's first and third columns; the second is
 // the chain's direction), radius r round `centre`: the ring's own ellipse (ringPointAt) moved and
 // made round.

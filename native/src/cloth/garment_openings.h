@@ -29,7 +29,8 @@
 namespace drape {
 
 // Gauss linking integral of the closed loop (last vertex joined to the first) and the open
-// polyline: the sum over segment pairs of the signed solid angle, over 4 pi.
+// polyline: the change of the loop's solid angle along the polyline, over 4 pi (computed over a
+// fan spanning the loop: garment_openings.cpp).
 float loopLinking(const std::vector<Vec3>& loop, const std::vector<Vec3>& polyline);
 
 struct OpeningCount {
