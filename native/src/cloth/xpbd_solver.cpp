@@ -21,7 +21,10 @@ namespace drape {
 namespace {
 
 using Vec4 = Eigen::Vector4f;
-constexpr size_t kLanes = 8;  // groups are padded to this: one AVX batch or two SSE batches
+// Groups are padded to this: one AVX-512 batch, two AVX batches or four SSE batches. (Padding to
+// 16 rather than 8 adds dummy constraints on the dummy particle: ~1 % more entries on the default
+// T-shirt; the order of real constraints, and so every result, is the same.)
+constexpr size_t kLanes = 16;
 
 bool finite(const Vec3& v) { return isFinite(v); }
 bool finite(float f) { return std::isfinite(f); }
@@ -227,21 +230,121 @@ __attribute__((target("avx"))) void projectBatchesAvx(Vec4* x, const uint32_t* A
 }
 #endif
 
+#if DRAPE_XPBD_AVX
+// The same kernel 16 constraints at a time (AVX-512F, Zen 4 and later): particles i, i+4, i+8 and
+// i+12 share one 512-bit register, so the transposes stay within 128-bit lanes as in the AVX
+// kernel, and a batch costs the same shuffles as eight constraints there. The same operations per
+// lane in the same order, and 1/|d| from the AVX estimate on each 256-bit half (AVX-512's own
+// rsqrt14 is a different estimate), so the same bits as the AVX and SSE kernels (test
+// ClothXpbd.WideProjectionMatchesEightLanesBitForBit). fp-contract off: AVX-512F has FMA, and a
+// fused multiply-add would round differently.
+#define DRAPE_AVX512_FN __attribute__((target("avx,avx512f"), optimize("fp-contract=off")))
+// GCC 12's AVX-512 intrinsics pass _mm512_undefined_ps() (a self-initialised variable) as the
+// unused merge source, and -Wuninitialized reports it at each use: a known false positive.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+DRAPE_AVX512_FN __attribute__((always_inline)) inline __m512 quad16(Vec4* x, const uint32_t* off, int i) {
+  __m512 r = _mm512_castps128_ps512(_mm_load_ps(at(x, off[i])));
+  r = _mm512_insertf32x4(r, _mm_load_ps(at(x, off[i + 4])), 1);
+  r = _mm512_insertf32x4(r, _mm_load_ps(at(x, off[i + 8])), 2);
+  return _mm512_insertf32x4(r, _mm_load_ps(at(x, off[i + 12])), 3);
+}
+DRAPE_AVX512_FN __attribute__((always_inline)) inline void gather16(Vec4* x, const uint32_t* off, __m512& px,
+                                                                    __m512& py, __m512& pz, __m512& pw) {
+  const __m512 r0 = quad16(x, off, 0), r1 = quad16(x, off, 1), r2 = quad16(x, off, 2), r3 = quad16(x, off, 3);
+  const __m512 t0 = _mm512_unpacklo_ps(r0, r1), t1 = _mm512_unpackhi_ps(r0, r1);
+  const __m512 t2 = _mm512_unpacklo_ps(r2, r3), t3 = _mm512_unpackhi_ps(r2, r3);
+  px = _mm512_shuffle_ps(t0, t2, 0x44);
+  py = _mm512_shuffle_ps(t0, t2, 0xEE);
+  pz = _mm512_shuffle_ps(t1, t3, 0x44);
+  pw = _mm512_shuffle_ps(t1, t3, 0xEE);
+}
+DRAPE_AVX512_FN __attribute__((always_inline)) inline void scatter16(Vec4* x, const uint32_t* off, __m512 px,
+                                                                     __m512 py, __m512 pz, __m512 pw) {
+  const __m512 t0 = _mm512_unpacklo_ps(px, py), t1 = _mm512_unpackhi_ps(px, py);
+  const __m512 t2 = _mm512_unpacklo_ps(pz, pw), t3 = _mm512_unpackhi_ps(pz, pw);
+  const __m512 r[4] = {_mm512_shuffle_ps(t0, t2, 0x44), _mm512_shuffle_ps(t0, t2, 0xEE),
+                       _mm512_shuffle_ps(t1, t3, 0x44), _mm512_shuffle_ps(t1, t3, 0xEE)};
+  for (int i = 0; i < 4; ++i) {
+    _mm_store_ps(at(x, off[i]), _mm512_castps512_ps128(r[i]));
+    _mm_store_ps(at(x, off[i + 4]), _mm512_extractf32x4_ps(r[i], 1));
+    _mm_store_ps(at(x, off[i + 8]), _mm512_extractf32x4_ps(r[i], 2));
+    _mm_store_ps(at(x, off[i + 12]), _mm512_extractf32x4_ps(r[i], 3));
+  }
+}
+// _mm256_rsqrt_ps on each half: the AVX and SSE kernels' estimate, bit for bit.
+DRAPE_AVX512_FN __attribute__((always_inline)) inline __m512 rsqrtAsAvx(__m512 v) {
+  const __m256 lo = _mm256_rsqrt_ps(_mm512_castps512_ps256(v));
+  const __m256 hi = _mm256_rsqrt_ps(_mm256_castpd_ps(_mm512_extractf64x4_pd(_mm512_castps_pd(v), 1)));
+  return _mm512_castpd_ps(_mm512_insertf64x4(_mm512_castps_pd(_mm512_castps256_ps512(lo)), _mm256_castps_pd(hi), 1));
+}
+
+template <Kind kKind>
+DRAPE_AVX512_FN void projectBatchesAvx512(Vec4* x, const uint32_t* A, const uint32_t* B, const float* rest,
+                                          const float* inv_w, size_t m, float scale) {
+  const __m512 vscale = _mm512_set1_ps(scale), zero = _mm512_setzero_ps();
+  const __m512 tiny2 = _mm512_set1_ps(1e-18f), half = _mm512_set1_ps(0.5f);
+  const __m512 three = _mm512_set1_ps(3.0f), one = _mm512_set1_ps(1.0f);
+  const __m512 inf = _mm512_set1_ps(std::numeric_limits<float>::infinity());
+  for (size_t k = 0; k < m; k += 16) {
+    __m512 ax, ay, az, aw, bx, by, bz, bw;
+    gather16(x, A + k, ax, ay, az, aw);
+    gather16(x, B + k, bx, by, bz, bw);
+    const __m512 dx = _mm512_sub_ps(ax, bx), dy = _mm512_sub_ps(ay, by), dz = _mm512_sub_ps(az, bz);
+    const __m512 len2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)),
+                                      _mm512_mul_ps(dz, dz));
+    const __mmask16 ok = _mm512_cmp_ps_mask(len2, tiny2, _CMP_GT_OQ);
+    __m512 y = rsqrtAsAvx(len2);
+    y = _mm512_mul_ps(_mm512_mul_ps(half, y), _mm512_sub_ps(three, _mm512_mul_ps(len2, _mm512_mul_ps(y, y))));
+    const __m512 r = _mm512_loadu_ps(rest + k);
+    __m512 s;
+    if (kKind != Kind::Equality) {
+      const __m512 c = _mm512_max_ps(_mm512_sub_ps(_mm512_mul_ps(len2, y), _mm512_mul_ps(r, vscale)), zero);
+      // As the AVX kernel: a batch of slack inequalities (and finite d) writes nothing.
+      const __mmask16 acts = _mm512_cmp_ps_mask(_mm512_maskz_mov_ps(ok, c), zero, _CMP_NEQ_UQ) |
+                             _mm512_cmp_ps_mask(len2, inf, _CMP_NLT_UQ);
+      if (acts == 0) continue;
+      s = _mm512_mul_ps(_mm512_mul_ps(c, y), _mm512_loadu_ps(inv_w + k));
+    } else {
+      s = _mm512_mul_ps(_mm512_sub_ps(one, _mm512_mul_ps(r, y)), _mm512_loadu_ps(inv_w + k));
+    }
+    s = _mm512_maskz_mov_ps(ok, s);  // +0 where |d| is too small, as the AVX kernel's and
+    const __m512 sa = _mm512_mul_ps(aw, s);
+    ax = _mm512_sub_ps(ax, _mm512_mul_ps(sa, dx));
+    ay = _mm512_sub_ps(ay, _mm512_mul_ps(sa, dy));
+    az = _mm512_sub_ps(az, _mm512_mul_ps(sa, dz));
+    scatter16(x, A + k, ax, ay, az, aw);
+    if (kKind != Kind::Tether) {
+      const __m512 sb = _mm512_mul_ps(bw, s);
+      bx = _mm512_add_ps(bx, _mm512_mul_ps(sb, dx));
+      by = _mm512_add_ps(by, _mm512_mul_ps(sb, dy));
+      bz = _mm512_add_ps(bz, _mm512_mul_ps(sb, dz));
+      scatter16(x, B + k, bx, by, bz, bw);
+    }
+  }
+}
+#pragma GCC diagnostic pop
+#endif
+
 // A, B: particle indices; A_off, B_off: the same as byte offsets (empty when they would not fit
 // 32 bits: then the SSE kernel).
 // Entries [first, end) of the lists (first a multiple of the batch width: a colour group's start).
 template <Kind kKind>
 void project(Vec4* x, const std::vector<uint32_t>& A, const std::vector<uint32_t>& B,
              const std::vector<uint32_t>& A_off, const std::vector<uint32_t>& B_off, const float* rest,
-             const float* inv_w, float scale, size_t first = 0) {
+             const float* inv_w, float scale, size_t first = 0, bool wide = true) {
   const size_t m = A.size();
   if (first >= m) return;
 #if DRAPE_XPBD_AVX
+  if (wide && cpuHasAvx512() && A_off.size() == m && B_off.size() == m)
+    return projectBatchesAvx512<kKind>(x, A_off.data() + first, B_off.data() + first, rest + first,
+                                       inv_w + first, m - first, scale);
   if (cpuHasAvx() && A_off.size() == m && B_off.size() == m)
     return projectBatchesAvx<kKind>(x, A_off.data() + first, B_off.data() + first, rest + first,
                                     inv_w + first, m - first, scale);
 #endif
-  (void)A_off, (void)B_off;
+  (void)A_off, (void)B_off, (void)wide;
   projectBatches<kKind>(x, A.data() + first, B.data() + first, rest + first, inv_w + first, m - first, scale);
 }
 
@@ -600,9 +703,9 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
   }
   for (int it = 0; it < p.iterations; ++it) {  // 1 by default: the method's single pass
     project<Kind::Equality>(x, distance_.a, distance_.b, distance_.a_off, distance_.b_off,
-                            distance_.rest.data(), distance_.inv_w.data(), 1.0f);
+                            distance_.rest.data(), distance_.inv_w.data(), 1.0f, 0, wide_projection_);
     project<Kind::Tether>(x, tethers_.a, tethers_.b, tethers_.a_off, tethers_.b_off, tethers_.rest.data(),
-                          tethers_.inv_w.data(), p.tether_scale);
+                          tethers_.inv_w.data(), p.tether_scale, 0, wide_projection_);
   }
   // The strain limit (XpbdParams::strain_limit) on the step's last substep, before collision so
   // that no particle is left inside an ellipsoid.
@@ -610,7 +713,7 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
   if (!predict_next && p.strain_limit > 0.0f) {
     for (int pass = 0; pass < p.strain_limit_passes; ++pass)
       project<Kind::Limit>(x, distance_.a, distance_.b, distance_.a_off, distance_.b_off, distance_.rest.data(),
-                           distance_.inv_w.data(), 1.0f + p.strain_limit, stretch_first_);
+                           distance_.inv_w.data(), 1.0f + p.strain_limit, stretch_first_, wide_projection_);
   }
   // 3. Collision against the tracking ellipsoids.
   if (collider != nullptr) {

@@ -141,6 +141,9 @@ class XpbdSolver {
   // On by default where the CPU has AVX: the per-substep velocity update and prediction two
   // particles at a time (the same bits as one at a time). Off: one at a time (tests compare).
   void setPairedUpdate(bool on) { paired_update_ = on; }
+  // On by default where the CPU has AVX-512F: constraints projected 16 at a time (the same bits as
+  // 8 or 4 at a time). Off: the AVX (or SSE) kernel (tests compare).
+  void setWideProjection(bool on) { wide_projection_ = on; }
   const XpbdTimings& lastTimings() const { return timings_; }
 
  private:
@@ -186,6 +189,7 @@ class XpbdSolver {
   CollisionStats collision_stats_;
   bool timing_ = false;
   bool paired_update_ = true;
+  bool wide_projection_ = true;
   XpbdTimings timings_;
 };
 
