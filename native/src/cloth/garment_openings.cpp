@@ -15,23 +15,30 @@ using D3 = Plain3<double>;
 // det(a, b, c) = a . (b x c).
 double det3(const D3& a, const D3& b, const D3& c) { return dot(a, cross(b, c)); }
 
-// 6 x the signed volume of the tetrahedron (p, P, Q, R): positive when p is on the side of the
-// triangle (P, Q, R) its counter-clockwise normal points away from. The numerator of the solid
-// angle, and the side test of the crossings: one expression for both, so that the solid angle's
-// jump and the crossing that makes up for it are seen on the same side of the plane.
-double side(const D3& p, const D3& P, const D3& Q, const D3& R) { return det3(P - p, Q - p, R - p); }
+// A side or solid-angle numerator this small against the product of the three distances (its
+// largest possible size) is rounding: the point is in the plane. Real garments put polyline points
+// there exactly: a pinned collar's opposite points are mirror images through the neck ring's
+// centre, which the spine passes through, so that centre lies on the fan edge from the loop's first
+// point to its opposite one, where one triangle's side came out 0 and its neighbour's 8e-22
+// (Ges04, test GarmentOpeningsGeometry.PolylinePointOnASharedFanEdge).
+constexpr double kPlaneTolerance = 1e-12;
 
-int sign(double v) { return v > 0.0 ? 1 : v < 0.0 ? -1 : 0; }
+// sign(side(p, P, Q, R)), 0 within the tolerance.
+int sideSign(const D3& p, const D3& P, const D3& Q, const D3& R) {
+  const D3 a = P - p, b = Q - p, c = R - p;
+  const double v = det3(a, b, c), tol = kPlaneTolerance * norm(a) * norm(b) * norm(c);
+  return v > tol ? 1 : v < -tol ? -1 : 0;
+}
 
 // Signed solid angle of the triangle (P, Q, R) seen from p (Van Oosterom & Strackee 1983):
 // in (-2 pi, 2 pi), positive from below (the side its counter-clockwise normal points away from),
 // jumping by -4 pi where p goes up through the triangle's interior. A point in the triangle's
 // plane gives 0: outside the triangle that is its value, inside it is the mean of the two sides.
 double solidAngle(const D3& p, const D3& P, const D3& Q, const D3& R) {
-  const double num = side(p, P, Q, R);
-  if (num == 0.0) return 0.0;
   const D3 a = P - p, b = Q - p, c = R - p;
+  const double num = det3(a, b, c);
   const double la = norm(a), lb = norm(b), lc = norm(c);
+  if (std::fabs(num) <= kPlaneTolerance * la * lb * lc) return 0.0;  // as sideSign's 0
   const double den = la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la;
   return 2.0 * std::atan2(num, den);
 }
@@ -74,7 +81,7 @@ float loopLinking(const std::vector<Vec3>& loop, const std::vector<Vec3>& polyli
       if (!in) continue;
       const double rim = edgeSign(v(k), v(k + 1));
       if (rim != 0.0 && (rim > 0.0) != pos) continue;
-      crossings += 0.5 * static_cast<double>(sign(side(a, apex, v(k), v(k + 1))) - sign(side(b, apex, v(k), v(k + 1))));
+      crossings += 0.5 * static_cast<double>(sideSign(a, apex, v(k), v(k + 1)) - sideSign(b, apex, v(k), v(k + 1)));
     }
   }
   return static_cast<float>(omega / (4.0 * static_cast<double>(kPi)) + crossings);
