@@ -238,12 +238,18 @@ __attribute__((target("avx"))) void projectBatchesAvx(Vec4* x, const uint32_t* A
 // rsqrt14 is a different estimate), so the same bits as the AVX and SSE kernels (test
 // ClothXpbd.WideProjectionMatchesEightLanesBitForBit). fp-contract off: AVX-512F has FMA, and a
 // fused multiply-add would round differently.
+// (Clang, the sanitizer build's compiler, contracts only within one expression, and each
+// intrinsic is its own function there: no attribute needed, and it has none of that name.)
+#if defined(__clang__)
+#define DRAPE_AVX512_FN __attribute__((target("avx,avx512f")))
+#else
 #define DRAPE_AVX512_FN __attribute__((target("avx,avx512f"), optimize("fp-contract=off")))
 // GCC 12's AVX-512 intrinsics pass _mm512_undefined_ps() (a self-initialised variable) as the
 // unused merge source, and -Wuninitialized reports it at each use: a known false positive.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wuninitialized"
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 DRAPE_AVX512_FN __attribute__((always_inline)) inline __m512 quad16(Vec4* x, const uint32_t* off, int i) {
   __m512 r = _mm512_castps128_ps512(_mm_load_ps(at(x, off[i])));
   r = _mm512_insertf32x4(r, _mm_load_ps(at(x, off[i + 4])), 1);
@@ -324,7 +330,9 @@ DRAPE_AVX512_FN void projectBatchesAvx512(Vec4* x, const uint32_t* A, const uint
     }
   }
 }
+#if !defined(__clang__)
 #pragma GCC diagnostic pop
+#endif
 #endif
 
 // A, B: particle indices; A_off, B_off: the same as byte offsets (empty when they would not fit
