@@ -146,13 +146,10 @@ void GarmentOpenings::bind(const std::vector<uint32_t>& triangles, const std::ve
 }
 
 template <class F>
-void GarmentOpenings::forEachOn(const Eigen::Vector4f* x, size_t n, const BodyModel& body, F&& f,
-                                bool limbs_only) const {
-  if (openings_.empty()) return;
+void GarmentOpenings::forEachOn(const Eigen::Vector4f* x, size_t n, const std::vector<std::vector<Vec3>>& parts,
+                                F&& f, bool limbs_only) const {
   // Scratch kept between calls: the rim gate runs this every step (GarmentSim::runStepFrame).
-  std::vector<std::vector<Vec3>>& parts = parts_scratch_;
   std::vector<Vec3>& at = loop_scratch_;
-  bodyPolylines(body, parts);
   for (const Opening& o : openings_) {
     if (limbs_only && o.part == 0) continue;  // bodyPolylines' first: the spine
     at.clear();
@@ -167,15 +164,18 @@ void GarmentOpenings::forEachOn(const Eigen::Vector4f* x, size_t n, const BodyMo
 OpeningCount GarmentOpenings::count(const Eigen::Vector4f* x, size_t n, const BodyModel& body) const {
   OpeningCount c;
   c.tracked = static_cast<uint32_t>(openings_.size());
-  forEachOn(x, n, body, [&](const Opening&, bool on) {
+  if (openings_.empty()) return c;
+  bodyPolylines(body, parts_scratch_);
+  forEachOn(x, n, parts_scratch_, [&](const Opening&, bool on) {
     if (!on) ++c.off;
   });
   return c;
 }
 
-void GarmentOpenings::markOn(const Eigen::Vector4f* x, size_t n, const BodyModel& body, std::vector<uint8_t>& on) const {
+void GarmentOpenings::markOn(const Eigen::Vector4f* x, size_t n, const std::vector<std::vector<Vec3>>& parts,
+                             std::vector<uint8_t>& on) const {
   on.assign(n, 0);
-  forEachOn(x, n, body, [&](const Opening& o, bool is_on) {
+  forEachOn(x, n, parts, [&](const Opening& o, bool is_on) {
     if (is_on)
       for (uint32_t i : o.loop) on[i] = 1;
   }, /*limbs_only=*/true);

@@ -62,7 +62,10 @@ class GarmentOpenings {
   // spine's openings, loops not tracked, interior particles). The rim gate (GarmentSim): a rim keeps
   // a limb in, not out; only a limb is thin enough to slip between two rim particles, and the
   // spine's hem and collar are the largest loops to test (docs/collision.md, "Rim edges").
-  void markOn(const Eigen::Vector4f* x, size_t n, const BodyModel& body, std::vector<uint8_t>& on) const;
+  // `parts`: the body-part polylines (bodyPolylines) of the body as it is where the particles are:
+  // the rim gate takes them from the start of a step (GarmentSim::runStepFrame), not its end.
+  void markOn(const Eigen::Vector4f* x, size_t n, const std::vector<std::vector<Vec3>>& parts,
+              std::vector<uint8_t>& on) const;
 
   // The body-part polylines (spine, arms, legs) of `body`: see the file comment.
   static std::vector<std::vector<Vec3>> bodyPolylines(const BodyModel& body);
@@ -76,12 +79,13 @@ class GarmentOpenings {
     int sign;                    // of the linking at rest
   };
   std::vector<Opening> openings_;  // the tracked ones only
-  mutable std::vector<std::vector<Vec3>> parts_scratch_;  // forEachOn's, kept between calls
+  mutable std::vector<std::vector<Vec3>> parts_scratch_;  // count's, kept between calls
   mutable std::vector<Vec3> loop_scratch_;
   // f(opening, on) for every tracked opening (limbs_only: those round an arm or a leg), on = round
-  // its body part now (count's test).
+  // its body part (parts[opening.part]) now (count's test).
   template <class F>
-  void forEachOn(const Eigen::Vector4f* x, size_t n, const BodyModel& body, F&& f, bool limbs_only = false) const;
+  void forEachOn(const Eigen::Vector4f* x, size_t n, const std::vector<std::vector<Vec3>>& parts, F&& f,
+                 bool limbs_only = false) const;
 };
 
 }  // namespace drape
