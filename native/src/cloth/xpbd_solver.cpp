@@ -22,8 +22,9 @@ namespace {
 
 using Vec4 = Eigen::Vector4f;
 // Groups are padded to this: one AVX-512 batch, two AVX batches or four SSE batches. (Padding to
-// 16 rather than 8 adds dummy constraints on the dummy particle: ~1 % more entries on the default
-// T-shirt; the order of real constraints, and so every result, is the same.)
+// 16 rather than 8 adds dummy constraints on the dummy particle: the default T-shirt's 10 434
+// distance constraints in 20 colour groups take 10 608 entries, 10 512 at 8, +0.9 %; the order of
+// real constraints, and so every result, is the same.)
 constexpr size_t kLanes = 16;
 
 bool finite(const Vec3& v) { return isFinite(v); }
