@@ -1,6 +1,5 @@
 // Openings (cloth/garment_openings.h): the boundary loops of a mesh (boundaryLoops,
 // cloth/garment_topology.h), the linking integral of a loop and a polyline, and every template's openings on the body it was dressed on, then carried off it.
-#include "body/body_shape.h"
 #include "cloth/garment_openings.h"
 #include "cloth/garment_solver.h"
 #include "cloth/garment_topology.h"
@@ -289,62 +288,6 @@ TEST_P(GarmentOpeningsOfTemplates, EveryOpeningRoundItsBodyPartUntilCarriedOff) 
   // ... and the gate marks nothing.
   o.markOn(g->positions(), g->particleCount(), GarmentOpenings::bodyPolylines(ctx.restBody()), on);
   EXPECT_EQ(std::count(on.begin(), on.end(), uint8_t{1}), 0);
-}
-
-// The rim gate tests the openings against the body where the garment is at a step's start: a
-// forearm moved forward in one frame (the joints 25 cm, the tracker's filter leaves 15 cm at the
-// hand), faster than its cuff can follow, is still in the cuff then, so the cuff's rims meet it
-// in that step. Against the step's end (the gate before
-// 2026-11-30) the same cuff read as off, and its rims went off just when the forearm pulled at it
-// (docs/garments.md, "The rim gate at the step's start").
-TEST(GarmentOpeningsOnTheBody, RimGateSeesTheBodyWhereTheGarmentIs) {
-  Context ctx(test::defaultDesc());
-  PipelineOptions po = ctx.pipelineOptions();
-  po.sleep = false;
-  ctx.setPipelineOptions(po);
-  std::string err;
-  GarmentSim* g = test::addTemplate(ctx, GarmentKind::LongSleeve, 1000, ClothSolverKind::Xpbd, GarmentSimParams{}, err);
-  ASSERT_NE(g, nullptr) << err;
-  const SkeletonPose rest = restPose(ctx.shape());
-  Recording rec;
-  rec.layout = Layout::Kinect2;
-  double t = 0.0;
-  auto step = [&](const SkeletonPose& pose) {
-    t += 1.0 / 30.0;
-    return test::pushAndStep(ctx, rec, test::kinect2FromPose(pose, t), t, 1.0f / 30.0f, err);
-  };
-  for (int f = 0; f < 15; ++f) ASSERT_EQ(step(rest), DRAPE_OK) << err;
-  // The right cuff: the boundary loop that goes round the right arm.
-  std::vector<Vec3> at;
-  const std::vector<std::vector<Vec3>> parts = GarmentOpenings::bodyPolylines(ctx.body());
-  std::vector<uint32_t> cuff;
-  for (const std::vector<uint32_t>& loop : boundaryLoops(g->mesh().indices, g->particleCount())) {
-    at.clear();
-    for (uint32_t i : loop) at.push_back(g->positions()[i].head<3>());
-    if (std::fabs(loopLinking(at, parts[2])) >= GarmentOpenings::kBindLinking) cuff = loop;  // parts[2]: ArmR
-  }
-  ASSERT_FALSE(cuff.empty());
-  const std::vector<Eigen::Vector4f> start(g->positions(), g->positions() + g->particleCount());
-  GarmentOpenings o;
-  std::vector<Vec3> settled(g->particleCount());
-  for (size_t i = 0; i < settled.size(); ++i) settled[i] = g->positions()[i].head<3>();
-  o.bind(g->mesh().indices, settled, ctx.body());
-
-  SkeletonPose moved = rest;
-  for (Joint j : {Joint::ElbowR, Joint::WristR, Joint::HandR})
-    moved.position[static_cast<size_t>(j)] += Vec3(0.0f, 0.0f, j == Joint::ElbowR ? 0.125f : 0.25f);
-  ASSERT_EQ(step(moved), DRAPE_OK) << err;
-  // The gate of that step: the cuff on (it went round the forearm where the garment was).
-  const std::vector<uint8_t>& gate = g->rimGate();
-  ASSERT_EQ(gate.size(), g->particleCount());
-  for (uint32_t i : cuff) EXPECT_EQ(gate[i], 1) << "cuff particle " << i;
-  // Against the moved body, the cuff where it was at that step's start is off its arm: what the
-  // gate saw before, and the reason this scene tests anything.
-  std::vector<uint8_t> old_gate;
-  o.markOn(start.data(), start.size(), GarmentOpenings::bodyPolylines(ctx.body()), old_gate);
-  size_t old_on = 0;
-  for (uint32_t i : cuff) old_on += old_gate[i];
-  EXPECT_EQ(old_on, 0u);
 }
 
 INSTANTIATE_TEST_SUITE_P(Kinds, GarmentOpeningsOfTemplates,

@@ -62,8 +62,8 @@ class GarmentOpenings {
   // spine's openings, loops not tracked, interior particles). The rim gate (GarmentSim): a rim keeps
   // a limb in, not out; only a limb is thin enough to slip between two rim particles, and the
   // spine's hem and collar are the largest loops to test (docs/collision.md, "Rim edges").
-  // `parts`: the body-part polylines (bodyPolylines) of the body as it is where the particles are:
-  // the rim gate takes them from the start of a step (GarmentSim::runStepFrame), not its end.
+  // `parts`: the body-part polylines (bodyPolylines) to test against (the rim gate's: the body at
+  // the step's end, GarmentSim::runStepFrame).
   void markOn(const Eigen::Vector4f* x, size_t n, const std::vector<std::vector<Vec3>>& parts,
               std::vector<uint8_t>& on) const;
 

@@ -692,10 +692,10 @@ void GarmentSim::runStepFrame(const std::vector<Ellipsoid>& start, const std::ve
   // outside and dragged it: docs/garments.md, "Rim edges"). The frames of a placement or a
   // restore run with every rim (the garment is dressed, or as it was, then).
   // Every step: marked every fourth step the ASan frame-rate scenario failed (docs/garments.md,
-  // "Rim edges": the gate's cost). Against the body where the garment is, at the step's start
-  // (gate_parts_): against its end, a forearm a few centimetres on from a cuff that has not yet
-  // followed it read as out of it, and the cuff's rims went off just when they were needed
-  // (docs/garments.md, "The rim gate at the step's start").
+  // "Rim edges": the gate's cost). Against the body at the step's end: against its start (the
+  // last step's end, carried) the ASan build's 10 Hz frame-rate scenario tore (docs/garments.md,
+  // "The rim gate at the step's start: tried, reverted").
+  GarmentOpenings::bodyPolylines(*pending_body_, gate_parts_);
   openings_.markOn(solver_->x(), particleCount(), gate_parts_, rim_gate_);
   solver_->setRimGate(rim_gate_);
   staging_ = allow_staging_;
@@ -721,10 +721,6 @@ void GarmentSim::stepBegin(const BodyModel& body, const std::vector<Ellipsoid>& 
     recheck_legs_ = 0;
   }
   const bool burst_ended = tracked_ && noiseBurstEnded();
-  // The rim gate's body (runStepFrame): the current body where the garment is put on it, carried
-  // to it or restored onto it below; the last step's end body, carried as the garment is, where
-  // the garment goes on from where that step left it.
-  GarmentOpenings::bodyPolylines(body, gate_parts_);
   if (!tracked_ || host_pose_jump_ || poseJumped(pr, dt)) {
     // First frame, or a pose no body reaches in dt from the last one (a skeleton flipped upside
     // down for a frame): the garment is put where the body's rings carry its dressed shape.
@@ -760,11 +756,6 @@ void GarmentSim::stepBegin(const BodyModel& body, const std::vector<Ellipsoid>& 
       const Mat3 R = partialRotation(pr.frame * seen_pelvis_f_.transpose(), fa);
       const Vec3 t = fl * (pr.centre - seen_pelvis_c_);
       carry(R, seen_pelvis_c_, t, 1.0f);
-      if (end_parts_valid_) {
-        gate_parts_ = end_parts_;
-        for (std::vector<Vec3>& part : gate_parts_)
-          for (Vec3& p : part) p = R * (p - seen_pelvis_c_) + seen_pelvis_c_ + t;
-      }
       carried_start_.resize(start.size());
       for (size_t k = 0; k < start.size(); ++k) {
         Ellipsoid e = start[k];
@@ -776,7 +767,6 @@ void GarmentSim::stepBegin(const BodyModel& body, const std::vector<Ellipsoid>& 
       pinTargets(body, pins_);
       runStepFrame(carried_start_, end, pins_, dt);
     } else {
-      if (end_parts_valid_) gate_parts_ = end_parts_;
       pinTargets(body, pins_);
       runStepFrame(start, end, pins_, dt);
     }
@@ -805,8 +795,6 @@ void GarmentSim::stepEnd() {
   }
   seen_pelvis_c_ = pr.centre;
   seen_pelvis_f_ = pr.frame;
-  GarmentOpenings::bodyPolylines(body, end_parts_);
-  end_parts_valid_ = true;
   keepCalmState(pr);
   ++steps_;
   last_.total_ms = msSince(pending_t0_);

@@ -302,9 +302,6 @@ class GarmentSim {
   // The tracker's sensor-noise estimate (SkeletonTracker::noiseSigmaM), given before each step.
   void setTrackingNoise(float sigma_m) { tracking_noise_m_ = sigma_m >= 0.0f ? sigma_m : 0.0f; }
   uint64_t steps() const { return steps_; }
-  // The rim gate of the last step (one byte per particle: its opening's rims met the ellipsoids
-  // in that step), for tests.
-  const std::vector<uint8_t>& rimGate() const { return rim_gate_; }
 
   // Accuracy now against `ellipsoids` and, when `body_bvh` is non-null, the body mesh it holds;
   // with `body` (the body now, same ring layout as at dressing), whether the openings still go
@@ -416,11 +413,8 @@ class GarmentSim {
   std::vector<uint8_t> masks_, groups_;  // groups_: base_groups_ as met now (applyLegGroups)
   std::vector<uint8_t> rim_gate_;        // runStepFrame: the particles of openings on their part
   // The body-part polylines (GarmentOpenings::bodyPolylines) the rim gate tests the openings
-  // against: the body where the garment is at the step's start (stepBegin sets them).
+  // against (runStepFrame's scratch, kept between steps).
   std::vector<std::vector<Vec3>> gate_parts_;
-  // The polylines of the body the last step ended on (stepEnd), and whether they are that body's.
-  std::vector<std::vector<Vec3>> end_parts_;
-  bool end_parts_valid_ = false;
   bool cuffs_past_elbow_ = false;  // longSleeves(): set when the openings are bound
   std::vector<uint8_t> base_groups_;      // each ellipsoid's collision groups, as given to create()
   // Torso cloth meets a leg's ellipsoid while the host trusts that leg (setLegsTrusted) and the
