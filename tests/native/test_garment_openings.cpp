@@ -248,16 +248,6 @@ TEST_P(GarmentOpeningsOfTemplates, EveryOpeningRoundItsBodyPartUntilCarriedOff) 
   const GarmentAccuracy dressed = g->measure(ctx.restEllipsoids(), nullptr, &ctx.restBody());
   EXPECT_EQ(dressed.openings.tracked, GetParam().openings);
   EXPECT_EQ(dressed.openings.off, 0u);
-  // Long sleeves (a cuff past the middle of the forearm) collide every substep, whatever stride
-  // the parameters ask for; the others every second (docs/garments.md, "Long sleeves collide
-  // every substep").
-  const bool long_sleeves = GetParam().kind == GarmentKind::LongSleeve;
-  EXPECT_EQ(g->longSleeves(), long_sleeves);
-  EXPECT_EQ(g->params().xpbd.collision_stride, long_sleeves ? 1 : 2);
-  GarmentSimParams every_third;
-  every_third.xpbd.collision_stride = 3;
-  ASSERT_TRUE(g->setParams(every_third, err)) << err;
-  EXPECT_EQ(g->params().xpbd.collision_stride, long_sleeves ? 1 : 3);
   // Without a body, nothing is counted.
   EXPECT_EQ(g->measure(ctx.restEllipsoids(), nullptr).openings.tracked, 0u);
 

@@ -67,12 +67,6 @@ class GarmentOpenings {
   void markOn(const Eigen::Vector4f* x, size_t n, const std::vector<std::vector<Vec3>>& parts,
               std::vector<uint8_t>& on) const;
 
-  // The tracked openings: how many, each one's loop (particle indices round it) and the body part
-  // it goes round (an index into bodyPolylines(): 0 spine, 1 left arm, 2 right arm, 3-4 legs).
-  size_t size() const { return openings_.size(); }
-  const std::vector<uint32_t>& loop(size_t k) const { return openings_[k].loop; }
-  uint32_t part(size_t k) const { return openings_[k].part; }
-
   // The body-part polylines (spine, arms, legs) of `body`: see the file comment.
   static std::vector<std::vector<Vec3>> bodyPolylines(const BodyModel& body);
   // The same into `out`, reusing its vectors' storage.

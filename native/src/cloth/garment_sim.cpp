@@ -326,21 +326,6 @@ bool GarmentSim::dress(Dressing& d, int frames, std::string& err) {
   }
   skin_.bind(body_rest, dressed_, kSkinBlendM);
   openings_.bind(mesh_.indices, dressed_, body_rest);
-  // Long sleeves collide every substep: their cuffs sit at the forearm and hand, the thinnest and
-  // fastest parts of the body, where every second substep let the arm out of the sleeve
-  // (docs/garments.md, "Long sleeves collide every substep").
-  cuffs_past_elbow_ = false;
-  for (size_t k = 0; k < openings_.size(); ++k) {
-    if (openings_.part(k) != 1 && openings_.part(k) != 2) continue;  // bodyPolylines: 1, 2 = the arms
-    Vec3 centre = Vec3::Zero();
-    for (uint32_t i : openings_.loop(k)) centre += dressed_[i];
-    centre /= static_cast<float>(openings_.loop(k).size());
-    float u = 0.0f;
-    const int chain = nearestChain(body_rest, body_rest.rings(), centre, &u);
-    const bool arm = static_cast<Chain>(chain) == Chain::ArmL || static_cast<Chain>(chain) == Chain::ArmR;
-    if (arm && u >= kLongSleeveCuffU) cuffs_past_elbow_ = true;
-  }
-  if (cuffs_past_elbow_ && !setParams(params_, err)) return false;
   last_ = GarmentStepStats{};
   d.finished = true;
   d.body = nullptr;
@@ -555,13 +540,11 @@ int GarmentSim::nearestChain(const BodyModel& body, const std::vector<RingPose>&
   return chain;
 }
 
-bool GarmentSim::setParams(const GarmentSimParams& given, std::string& err) {
-  if (std::string e = validate(given); !e.empty()) {
+bool GarmentSim::setParams(const GarmentSimParams& params, std::string& err) {
+  if (std::string e = validate(params); !e.empty()) {
     err = e;
     return false;
   }
-  GarmentSimParams params = given;
-  if (cuffs_past_elbow_) params.xpbd.collision_stride = 1;
   if (!solver_->setParams(params, err)) return false;
   params_ = params;
   return true;

@@ -49,8 +49,7 @@ struct GarmentSimParams {
   // Collision runs every second substep (150 Hz at the default 300 Hz; the swept test covers the
   // two substeps): collision cost halves and stretch, penetration and particles inside stay
   // within the run-to-run noise on the shared takes; every third substep made the 120 Hz BVH
-  // takes (3 substeps a frame) unstable (docs/garments.md). Garments with long sleeves collide
-  // every substep all the same (setParams, longSleeves()).
+  // takes (3 substeps a frame) unstable (docs/garments.md).
   // The strain limit (10 %, two passes at the end of each step, XpbdParams::strain_limit): on the
   // shared takes x templates the pooled P99 stretch fell in 37 of 40 runs (geometric mean x 0.82,
   // Ges01 T-shirt 16.2 -> 12.4 %) with the body penetration within the run-to-run noise, for
@@ -196,14 +195,7 @@ class GarmentSim {
   void replaceWith(GarmentSim&& fresh);
   uint32_t refits() const { return refits_; }
 
-  // A garment with long sleeves (cuffs_past_elbow_) collides every substep whatever
-  // params.xpbd.collision_stride says (docs/garments.md, "Long sleeves collide every substep").
   bool setParams(const GarmentSimParams& params, std::string& err);
-  // Whether an opening round an arm sits past the middle of the forearm on the dressed garment.
-  bool longSleeves() const { return cuffs_past_elbow_; }
-  // An arm opening whose centre lies this far along its arm (u: 0 shoulder, 1 elbow, 2 wrist) or
-  // farther is a long sleeve's cuff.
-  static constexpr float kLongSleeveCuffU = 1.5f;
   const GarmentSimParams& params() const { return params_; }
   ClothSolverKind solver() const { return kind_; }
 
@@ -415,7 +407,6 @@ class GarmentSim {
   // The body-part polylines (GarmentOpenings::bodyPolylines) the rim gate tests the openings
   // against (runStepFrame's scratch, kept between steps).
   std::vector<std::vector<Vec3>> gate_parts_;
-  bool cuffs_past_elbow_ = false;  // longSleeves(): set when the openings are bound
   std::vector<uint8_t> base_groups_;      // each ellipsoid's collision groups, as given to create()
   // Torso cloth meets a leg's ellipsoid while the host trusts that leg (setLegsTrusted) and the
   // ellipsoid is clear: it held no torso cloth when the garment was last placed on the body (first
