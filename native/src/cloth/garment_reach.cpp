@@ -17,7 +17,7 @@ std::vector<ReachSphere> garmentReach(const GarmentSim& garment, const ReachPara
   const GarmentMesh& mesh = garment.mesh();
   const std::vector<uint8_t>& masks = garment.particleMasks();
   const size_t n = topo.particleCount();
-  constexpr float kInf = std::numeric_limits<float>::infinity();
+  constexpr float kUnreached = std::numeric_limits<float>::infinity();
 
   // Multi-source Dijkstra from the attached particles over the mesh edges (the stretch
   // constraints are every edge, with its rest length).
@@ -27,7 +27,7 @@ std::vector<ReachSphere> garmentReach(const GarmentSim& garment, const ReachPara
     adjacency[edges.a[e]].push_back({edges.b[e], edges.rest[e]});
     adjacency[edges.b[e]].push_back({edges.a[e], edges.rest[e]});
   }
-  std::vector<float> dist(n, kInf);
+  std::vector<float> dist(n, kUnreached);
   std::vector<int> source(n, -1);  // attachment (index into mesh.pinned) a particle is nearest to
   using Item = std::pair<float, uint32_t>;
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> open;
@@ -78,7 +78,7 @@ std::vector<ReachSphere> garmentReach(const GarmentSim& garment, const ReachPara
     s.radius_m = pinOffset[key.first] + params.stretch_allowance * d + params.margin_m;
     out.push_back(s);
   }
-  if (loose != 0) out.push_back(ReachSphere{-1, loose, kInf});
+  if (loose != 0) out.push_back(ReachSphere{-1, loose, kUnreached});
   return out;
 }
 
