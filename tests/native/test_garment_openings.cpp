@@ -9,8 +9,8 @@
 
 #include <algorithm>
 #include <array>
-#include <initializer_list>
 #include <cmath>
+#include <initializer_list>
 #include <vector>
 
 namespace drape {

@@ -677,7 +677,7 @@ void GarmentSim::runStepFrame(const std::vector<Ellipsoid>& start, const std::ve
   // Every step: marked every fourth step the ASan frame-rate scenario failed (docs/garments.md,
   // "Rim edges": the gate's cost). Against the body at the step's end: against its start (the
   // last step's end, carried) the ASan build's 10 Hz frame-rate scenario tore (docs/garments.md,
-  // "The rim gate at the step's start: tried, reverted").
+  // "The rim gate at the step's start").
   GarmentOpenings::bodyPolylines(*pending_body_, gate_parts_);
   openings_.markOn(solver_->x(), particleCount(), gate_parts_, rim_gate_);
   solver_->setRimGate(rim_gate_);
