@@ -260,7 +260,7 @@ void drape_phase_rims(__global const DrapeClGarment* table, uint count, __global
       const uint begin = groups[g->rim_group_offset + c], end = groups[g->rim_group_offset + c + 1u];
       for (uint k = begin + lid; k < end; k += DRAPE_CL_WORK_GROUP) {
         const DrapeClConstraint r = constraints[k];
-          if (!(r.w_sum > 0.0f)) continue;  /* gated off (ClXpbdSolver::setRimGate) or both ends pinned */
+        if (!(r.w_sum > 0.0f)) continue;  /* gated off (ClXpbdSolver::setRimGate) or both ends pinned */
         float4 pa = x[o + r.a], pb = x[o + r.b];
         const uint ma = grouped ? (uint)masks[o + r.a] : 0xFFu;
         const uint mb = grouped ? (uint)masks[o + r.b] : 0xFFu;

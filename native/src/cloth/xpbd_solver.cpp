@@ -316,7 +316,7 @@ DRAPE_AVX512_FN void projectBatchesAvx512(Vec4* x, const uint32_t* A, const uint
     } else {
       s = _mm512_mul_ps(_mm512_sub_ps(one, _mm512_mul_ps(r, y)), _mm512_loadu_ps(inv_w + k));
     }
-    s = _mm512_maskz_mov_ps(ok, s);  // +0 where |d| is too small, as the AVX kernel's and
+    s = _mm512_maskz_mov_ps(ok, s);  // +0 where |d| is too small, as the AVX kernel's _mm256_and_ps
     const __m512 sa = _mm512_mul_ps(aw, s);
     ax = _mm512_sub_ps(ax, _mm512_mul_ps(sa, dx));
     ay = _mm512_sub_ps(ay, _mm512_mul_ps(sa, dy));

@@ -1,6 +1,6 @@
 // What the CPU the library runs on can do, checked once at run time: the 8-wide AVX kernels (XPBD
-// projection, collision pass 0) and the 16-wide AVX-512 one (XPBD projection) are chosen per call, so one build runs on every x86-64. Also the
-// inlining hints those hot loops share.
+// projection, collision pass 0) and the 16-wide AVX-512 one (XPBD projection) are chosen per call,
+// so one build runs on every x86-64. Also the inlining hints those hot loops share.
 #pragma once
 
 #if defined(__GNUC__)
