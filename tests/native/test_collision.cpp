@@ -767,15 +767,16 @@ TEST(Collider, BroadPhaseOnOffIdentical) {
   }
 }
 
-// Pass 0 for eight particles at once (CollisionParams::batch8, AVX) against one at a time: the
-// same positions and counters bit for bit, with and without collision groups, the swept test, a
-// start position, the broad phase; lanes with a non-finite start position, pinned or NaN
-// particles and particles far from everything mixed in.
-TEST(Collider, EightAtOnceMatchesOneAtATimeBitForBit) {
+// Pass 0 for eight particles at once (CollisionParams::batch8, AVX) and for sixteen (batch16,
+// AVX-512F) against one at a time: the same positions and counters bit for bit, with and without
+// collision groups, the swept test, a start position, the broad phase; lanes with a non-finite
+// start position, pinned or NaN particles and particles far from everything mixed in. 4 011
+// particles: 250 batches of sixteen, then one of eight and three one at a time.
+TEST(Collider, BatchesMatchOneAtATimeBitForBit) {
   // 40, 130 and 250 ellipsoids: one, three and four bitmask words per grid cell; the 40 also
   // scaled 10x (radii up to 2.2 m: the exact response's Newton iteration then needs its w lane).
   for (int n : {40, 130, 250, -40}) {
-    Scene s = randomScene(std::abs(n), test::repeatsUnderSanitizers(4000, 4), 700u + static_cast<unsigned>(std::abs(n)));
+    Scene s = randomScene(std::abs(n), test::repeatsUnderSanitizers(4011, 4), 700u + static_cast<unsigned>(std::abs(n)));
     if (n < 0) {
       for (std::vector<Ellipsoid>* es : {&s.start, &s.end}) {
         for (Ellipsoid& e : *es) {
@@ -808,18 +809,25 @@ TEST(Collider, EightAtOnceMatchesOneAtATimeBitForBit) {
         p.continuous = (variant & 2) != 0;
         p.broad_phase = (variant & 4) != 0;
         const bool with_prev = variant != 6;
-        std::vector<Vec4> a = s.x, b = s.x;
-        p.batch8 = true;
-        const CollisionStats sa = col.collide(a.data(), with_prev ? s.prev.data() : nullptr, a.size(), p);
         p.batch8 = false;
+        std::vector<Vec4> b = s.x;
         const CollisionStats sb = col.collide(b.data(), with_prev ? s.prev.data() : nullptr, b.size(), p);
-        SCOPED_TRACE(::testing::Message() << n << " ellipsoids, grouped " << grouped << " variant " << variant);
-        EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec4)), 0);
-        EXPECT_EQ(sa.tests, sb.tests);
-        EXPECT_EQ(sa.contacts, sb.contacts);
-        EXPECT_EQ(sa.swept_catches, sb.swept_catches);
-        EXPECT_EQ(sa.escapes, sb.escapes);
-        EXPECT_GT(sa.contacts, static_cast<uint32_t>(s.x.size()) / 100);
+        // Eight lanes (batch16 off), then sixteen (batch16 on: eight lanes where the CPU lacks
+        // AVX-512F, and the last count % 16 particles in a batch of eight and one at a time).
+        for (bool sixteen : {false, true}) {
+          p.batch8 = true;
+          p.batch16 = sixteen;
+          std::vector<Vec4> a = s.x;
+          const CollisionStats sa = col.collide(a.data(), with_prev ? s.prev.data() : nullptr, a.size(), p);
+          SCOPED_TRACE(::testing::Message() << n << " ellipsoids, grouped " << grouped << " variant " << variant
+                                            << (sixteen ? ", sixteen lanes" : ", eight lanes"));
+          EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec4)), 0);
+          EXPECT_EQ(sa.tests, sb.tests);
+          EXPECT_EQ(sa.contacts, sb.contacts);
+          EXPECT_EQ(sa.swept_catches, sb.swept_catches);
+          EXPECT_EQ(sa.escapes, sb.escapes);
+          EXPECT_GT(sa.contacts, static_cast<uint32_t>(s.x.size()) / 100);
+        }
       }
     }
   }

@@ -570,7 +570,10 @@ CollisionStats EllipsoidCollider::collide(Eigen::Vector4f* positions,
   const bool grouped = particle_masks_ != nullptr && !allowed_.empty() &&
                        groups_.size() == shapes_.size() && shapes_.size() <= static_cast<size_t>(kMaxGridEllipsoids);
   size_t i = 0;
-  if (p.batch8) i = collideEights(positions, previous, count, p, grouped, st);
+  if (p.batch8) {
+    if (p.batch16) i = collideSixteens(positions, previous, i, count, p, grouped, st);
+    i = collideEights(positions, previous, i, count, p, grouped, st);
+  }
   for (; i < count; ++i) {
     if (!mayTouch(positions, previous, i, swept)) continue;
     const Vec3 x = positions[i].head<3>();

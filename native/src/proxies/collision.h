@@ -38,6 +38,10 @@ struct CollisionParams {
   // AVX: the same tests in the same order and arithmetic per particle, so the same results
   // (bit-identical); off = one particle at a time. docs/collision.md, "Eight particles at once".
   bool batch8 = true;
+  // With batch8: sixteen particles at once where the CPU has AVX-512F (the same results again;
+  // fewer candidates per particle, as a batch's neighbours share their ellipsoids). docs/collision.md,
+  // "Sixteen particles at once".
+  bool batch16 = true;
   // The cloth solvers collide a garment's rim edges too (collideRims) after its particles.
   bool rims = true;
 };
@@ -177,11 +181,13 @@ class EllipsoidCollider {
   // ellipsoid -> the escape step.
   void escapeIfInside(Vec3& x, const CollisionParams& p, bool use_grid, const uint64_t* allowed,
                       CollisionStats& stats) const;
-  // settle() for the lanes `lanes` of collideEights' block, whose joint candidates ks[0..n) cover
-  // them (collision_eight_contacts.cpp).
-  void settleEight(const int* ks, int n, int lanes, uint64_t lane_masks, bool mixed, float* xx, float* xy,
-                   float* xz, const CollisionParams& p, bool use_grid, size_t begin, bool grouped,
-                   CollisionStats& st) const;
+  // settle()'s first sequential pass for the lanes `lanes` of a batch of pass 0, whose joint
+  // candidates ks[0..n) cover them; lane_masks: the lanes' collision masks (one byte each) when
+  // they differ, else null (collision_batch.inc). Eight lanes (AVX) and sixteen (AVX-512F).
+  void settleEight(const int* ks, int n, int lanes, const uint8_t* lane_masks, float* xx, float* xy, float* xz,
+                   const CollisionParams& p, bool use_grid, size_t begin, bool grouped, CollisionStats& st) const;
+  void settleSixteen(const int* ks, int n, int lanes, const uint8_t* lane_masks, float* xx, float* xy, float* xz,
+                     const CollisionParams& p, bool use_grid, size_t begin, bool grouped, CollisionStats& st) const;
   // The ellipsoids a particle with collision mask `mask` may touch (allowed_'s row), and particle
   // i's row when collide() uses groups (null otherwise).
   const uint64_t* allowedRow(uint8_t mask) const {
@@ -192,20 +198,28 @@ class EllipsoidCollider {
   }
   // Whether particle i of collide() can touch anything (collision_internal.h).
   bool mayTouch(const Eigen::Vector4f* positions, const Eigen::Vector4f* previous, size_t i, bool swept) const;
-  // collide() for particles [0, count - count % 8), eight at a time (CollisionParams::batch8).
-  // Returns how many it handled: 0 (nothing done) when the CPU has no AVX or there are more
-  // ellipsoids than kMaxGridEllipsoids.
-  size_t collideEights(Eigen::Vector4f* positions, const Eigen::Vector4f* previous, size_t count,
+  // collide() for particles [first, count), a batch of consecutive particles at a time: eight
+  // (CollisionParams::batch8, AVX) or sixteen (with CollisionParams::batch16 too, AVX-512F).
+  // Returns where it stopped (first + a multiple of the batch), the rest left to the caller:
+  // first (nothing done) when the CPU lacks the width's instructions or there are more
+  // ellipsoids than kMaxGridEllipsoids. collision_batch.inc.
+  size_t collideEights(Eigen::Vector4f* positions, const Eigen::Vector4f* previous, size_t first, size_t count,
                        const CollisionParams& p, bool grouped, CollisionStats& st) const;
-  // contact() for the lanes of `lanes` of collideEights' block against ellipsoid k, where each is
-  // inside (discrete contact) and the response is Exact, eight lanes at once: the same arithmetic
-  // in the same order per lane. Returns the lanes it answered (their x updated, st.contacts
-  // counted); the rest (closest point not found in float, or a deep contact that may need the
-  // entry point) are left for contact(). The arrays are collideEights' lanes (8 floats each).
+  size_t collideSixteens(Eigen::Vector4f* positions, const Eigen::Vector4f* previous, size_t first, size_t count,
+                         const CollisionParams& p, bool grouped, CollisionStats& st) const;
+  // contact() for the lanes of `lanes` of a batch against ellipsoid k, where each is inside
+  // (discrete contact) and the response is Exact, all lanes at once: the same arithmetic in the
+  // same order per lane. Returns the lanes it answered (their x updated, st.contacts counted); the
+  // rest (closest point not found in float, or a deep contact that may need the entry point) are
+  // left for contact(). The arrays are the batch's lanes (8 or 16 floats each).
   int exactContactsEight(int k, int lanes, const float* q1x, const float* q1y, const float* q1z, const float* r2,
                          const float* q0x, const float* q0y, const float* q0z, const float* q0sq,
                          const float* x0x, const float* x0y, const float* x0z, bool cont, bool friction,
                          const CollisionParams& p, float* xx, float* xy, float* xz, CollisionStats& st) const;
+  int exactContactsSixteen(int k, int lanes, const float* q1x, const float* q1y, const float* q1z, const float* r2,
+                           const float* q0x, const float* q0y, const float* q0z, const float* q0sq,
+                           const float* x0x, const float* x0y, const float* x0z, bool cont, bool friction,
+                           const CollisionParams& p, float* xx, float* xy, float* xz, CollisionStats& st) const;
   Vec3 respond(const Shape& s, const Vec3& x, const Vec3& q, float r2, ContactResponse mode,
                Vec3& q_contact) const;
   void refreshQuick(int k);
