@@ -1,4 +1,4 @@
-// Internal to the ellipsoid collider (collision.cpp and collision_eight.cpp): the small vector
+// Internal to the ellipsoid collider (collision.cpp and collision_batch.cpp): the small vector
 // helpers both share, and the broad phase's candidate machinery (gather, covers, iterate), defined
 // here so that both translation units inline it.
 #pragma once
