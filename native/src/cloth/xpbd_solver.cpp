@@ -35,20 +35,74 @@ double nsBetween(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::nano>(b - a).count();
 }
 
+// The entries [g0, g1) of colour group `g` of `c` in the order appendPadded stores them: first
+// `*quad_batches` batches of kLanes whose lanes q, q + 4, q + 8, q + 12 hold four constraints
+// (a, b), (a + 1, b + 1), (a + 2, b + 2), (a + 3, b + 3) (a "quad": both ends four consecutive
+// particles, as a template's rows of edges are), for q = 0..3; then the rest in the colour's order.
+// Within a colour no two constraints share a particle that either writes, so this order gives the
+// same bits as any other; it lets the AVX-512 kernel load and store a quad's four particles as one
+// 64-byte vector (QuadRuns).
+std::vector<uint32_t> quadOrder(const DistanceConstraints& c, uint32_t g0, uint32_t g1, uint32_t particles,
+                                std::vector<int32_t>& entry_of_a, size_t* quad_batches) {
+  std::vector<uint32_t> by_a(g1 - g0);
+  for (uint32_t k = g0; k < g1; ++k) by_a[k - g0] = k;
+  std::sort(by_a.begin(), by_a.end(), [&](uint32_t i, uint32_t j) { return c.a[i] < c.a[j]; });
+  // A particle is `a` of at most one constraint of a colour (a writes), so `a` finds its entry.
+  for (uint32_t k = g0; k < g1; ++k) entry_of_a[c.a[k]] = static_cast<int32_t>(k);
+  std::vector<uint8_t> used(g1 - g0, 0);
+  std::vector<uint32_t> quads;  // four entries per quad, in order of a
+  for (uint32_t k : by_a) {
+    if (used[k - g0]) continue;
+    uint32_t e[4] = {k, 0, 0, 0};
+    bool quad = true;
+    for (uint32_t j = 1; j < 4 && quad; ++j) {
+      const uint32_t aj = c.a[k] + j;
+      const int32_t ej = aj < particles ? entry_of_a[aj] : -1;
+      quad = ej >= 0 && !used[static_cast<uint32_t>(ej) - g0] && c.b[static_cast<uint32_t>(ej)] == c.b[k] + j;
+      if (quad) e[j] = static_cast<uint32_t>(ej);
+    }
+    if (!quad) continue;
+    for (uint32_t ej : e) {
+      used[ej - g0] = 1;
+      quads.push_back(ej);
+    }
+  }
+  for (uint32_t k = g0; k < g1; ++k) entry_of_a[c.a[k]] = -1;
+  constexpr size_t kQuadsPerBatch = kLanes / 4;
+  *quad_batches = quads.size() / 4 / kQuadsPerBatch;
+  std::vector<uint32_t> order;
+  order.reserve(g1 - g0);
+  for (size_t batch = 0; batch < *quad_batches; ++batch) {
+    const uint32_t* q = quads.data() + batch * kLanes;  // the batch's four quads
+    for (size_t lane = 0; lane < kLanes; ++lane) order.push_back(q[(lane % 4) * 4 + lane / 4]);
+  }
+  std::fill(used.begin(), used.end(), 0);
+  for (uint32_t k : order) used[k - g0] = 1;
+  for (uint32_t k = g0; k < g1; ++k)
+    if (!used[k - g0]) order.push_back(k);
+  return order;
+}
+
 // Appends the colour groups of `c` to `out`, each padded to a multiple of kLanes with dummy
-// constraints on particle `dummy`.
+// constraints on particle `dummy` (= the particle count), each in quadOrder, with the entries of
+// its quad batches added to `quad_runs` ([begin, end) ranges).
 void appendPadded(const DistanceConstraints& c, float compliance, uint32_t dummy,
                   std::vector<uint8_t>* kinds, uint8_t kind,
                   std::vector<uint32_t>& a, std::vector<uint32_t>& b, std::vector<float>& rest,
-                  std::vector<float>& comp, std::vector<uint32_t>& offsets) {
+                  std::vector<float>& comp, std::vector<uint32_t>& offsets,
+                  std::vector<std::pair<uint32_t, uint32_t>>& quad_runs) {
+  std::vector<int32_t> entry_of_a(dummy, -1);
   for (size_t g = 0; g < c.colours(); ++g) {
-    for (uint32_t k = c.colour_offsets[g]; k < c.colour_offsets[g + 1]; ++k) {
+    size_t quad_batches = 0;
+    const uint32_t start = static_cast<uint32_t>(a.size());
+    for (uint32_t k : quadOrder(c, c.colour_offsets[g], c.colour_offsets[g + 1], dummy, entry_of_a, &quad_batches)) {
       a.push_back(c.a[k]);
       b.push_back(c.b[k]);
       rest.push_back(c.rest[k]);
       comp.push_back(compliance);
       if (kinds) kinds->push_back(kind);
     }
+    if (quad_batches > 0) quad_runs.emplace_back(start, static_cast<uint32_t>(start + quad_batches * kLanes));
     while (a.size() % kLanes != 0) {
       a.push_back(dummy);
       b.push_back(dummy);
@@ -157,77 +211,102 @@ __attribute__((target("avx"), always_inline)) inline float* at(Vec4* x, uint32_t
 __attribute__((target("avx"), always_inline)) inline __m256 pair8(Vec4* x, const uint32_t* off, int i) {
   return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(at(x, off[i]))), _mm_load_ps(at(x, off[i + 4])), 1);
 }
+// kQuads: a quad batch (Batches::quad_runs): lanes i and i + 4 are consecutive particles, one
+// 32-byte load (store) instead of two 16-byte ones.
+template <bool kQuads>
 __attribute__((target("avx"), always_inline)) inline void gather8(Vec4* x, const uint32_t* off, __m256& px,
-                                                   __m256& py, __m256& pz, __m256& pw) {
-  const __m256 r0 = pair8(x, off, 0), r1 = pair8(x, off, 1), r2 = pair8(x, off, 2),
-               r3 = pair8(x, off, 3);
-  const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1);
-  const __m256 t2 = _mm256_unpacklo_ps(r2, r3), t3 = _mm256_unpackhi_ps(r2, r3);
+                                                                  __m256& py, __m256& pz, __m256& pw) {
+  __m256 r[4];
+  for (int i = 0; i < 4; ++i) r[i] = kQuads ? _mm256_loadu_ps(at(x, off[i])) : pair8(x, off, i);
+  const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
+  const __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
   px = _mm256_shuffle_ps(t0, t2, 0x44);
   py = _mm256_shuffle_ps(t0, t2, 0xEE);
   pz = _mm256_shuffle_ps(t1, t3, 0x44);
   pw = _mm256_shuffle_ps(t1, t3, 0xEE);
 }
+template <bool kQuads>
 __attribute__((target("avx"), always_inline)) inline void scatter8(Vec4* x, const uint32_t* off, __m256 px,
-                                                    __m256 py, __m256 pz, __m256 pw) {
+                                                                   __m256 py, __m256 pz, __m256 pw) {
   const __m256 t0 = _mm256_unpacklo_ps(px, py), t1 = _mm256_unpackhi_ps(px, py);
   const __m256 t2 = _mm256_unpacklo_ps(pz, pw), t3 = _mm256_unpackhi_ps(pz, pw);
   const __m256 r[4] = {_mm256_shuffle_ps(t0, t2, 0x44), _mm256_shuffle_ps(t0, t2, 0xEE),
                        _mm256_shuffle_ps(t1, t3, 0x44), _mm256_shuffle_ps(t1, t3, 0xEE)};
   for (int i = 0; i < 4; ++i) {
+    if (kQuads) {
+      _mm256_storeu_ps(at(x, off[i]), r[i]);
+      continue;
+    }
     _mm_store_ps(at(x, off[i]), _mm256_castps256_ps128(r[i]));
     _mm_store_ps(at(x, off[i + 4]), _mm256_extractf128_ps(r[i], 1));
   }
 }
 
-template <Kind kKind>
-__attribute__((target("avx"))) void projectBatchesAvx(Vec4* x, const uint32_t* A, const uint32_t* B,
-                                                      const float* rest, const float* inv_w,
-                                                      size_t m, float scale) {
-  const __m256 vscale = _mm256_set1_ps(scale), zero = _mm256_setzero_ps();
+// One batch of 8 constraints (entries A[0..8), ...).
+template <Kind kKind, bool kQuads>
+__attribute__((target("avx"), always_inline)) inline void projectBatch8(Vec4* x, const uint32_t* A,
+                                                                        const uint32_t* B, const float* rest,
+                                                                        const float* inv_w, __m256 vscale) {
+  const __m256 zero = _mm256_setzero_ps();
   const __m256 tiny2 = _mm256_set1_ps(1e-18f), half = _mm256_set1_ps(0.5f);
   const __m256 three = _mm256_set1_ps(3.0f), one = _mm256_set1_ps(1.0f);
   const __m256 inf = _mm256_set1_ps(std::numeric_limits<float>::infinity());
-  for (size_t k = 0; k < m; k += 8) {
-    __m256 ax, ay, az, aw, bx, by, bz, bw;
-    gather8(x, A + k, ax, ay, az, aw);
-    gather8(x, B + k, bx, by, bz, bw);
-    const __m256 dx = _mm256_sub_ps(ax, bx), dy = _mm256_sub_ps(ay, by), dz = _mm256_sub_ps(az, bz);
-    const __m256 len2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
-                                      _mm256_mul_ps(dz, dz));
-    const __m256 ok = _mm256_cmp_ps(len2, tiny2, _CMP_GT_OQ);
-    __m256 y = _mm256_rsqrt_ps(len2);
-    y = _mm256_mul_ps(_mm256_mul_ps(half, y),
-                      _mm256_sub_ps(three, _mm256_mul_ps(len2, _mm256_mul_ps(y, y))));
-    const __m256 r = _mm256_loadu_ps(rest + k);
-    __m256 s;
-    if (kKind != Kind::Equality) {
-      const __m256 c = _mm256_max_ps(_mm256_sub_ps(_mm256_mul_ps(len2, y), _mm256_mul_ps(r, vscale)), zero);
-      // Most tethers, and nearly every edge against the strain limit, are slack (inactive
-      // inequalities): when every lane's violation is zero and its d finite, the stores would
-      // write back what was read; skip them (same bits), before inv_w is read. A lane whose
-      // correction comes out zero anyway (inv_w 0: both ends pinned) writes back its own bits.
-      const __m256 acts = _mm256_or_ps(_mm256_cmp_ps(_mm256_and_ps(ok, c), zero, _CMP_NEQ_UQ),
-                                       _mm256_cmp_ps(len2, inf, _CMP_NLT_UQ));
-      if (_mm256_movemask_ps(acts) == 0) continue;
-      s = _mm256_mul_ps(_mm256_mul_ps(c, y), _mm256_loadu_ps(inv_w + k));
-    } else {
-      s = _mm256_mul_ps(_mm256_sub_ps(one, _mm256_mul_ps(r, y)), _mm256_loadu_ps(inv_w + k));
-    }
-    s = _mm256_and_ps(ok, s);
-    const __m256 sa = _mm256_mul_ps(aw, s);
-    ax = _mm256_sub_ps(ax, _mm256_mul_ps(sa, dx));
-    ay = _mm256_sub_ps(ay, _mm256_mul_ps(sa, dy));
-    az = _mm256_sub_ps(az, _mm256_mul_ps(sa, dz));
-    scatter8(x, A + k, ax, ay, az, aw);
-    if (kKind != Kind::Tether) {
-      const __m256 sb = _mm256_mul_ps(bw, s);
-      bx = _mm256_add_ps(bx, _mm256_mul_ps(sb, dx));
-      by = _mm256_add_ps(by, _mm256_mul_ps(sb, dy));
-      bz = _mm256_add_ps(bz, _mm256_mul_ps(sb, dz));
-      scatter8(x, B + k, bx, by, bz, bw);
-    }
+  __m256 ax, ay, az, aw, bx, by, bz, bw;
+  gather8<kQuads>(x, A, ax, ay, az, aw);
+  gather8<kQuads>(x, B, bx, by, bz, bw);
+  const __m256 dx = _mm256_sub_ps(ax, bx), dy = _mm256_sub_ps(ay, by), dz = _mm256_sub_ps(az, bz);
+  const __m256 len2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
+                                    _mm256_mul_ps(dz, dz));
+  const __m256 ok = _mm256_cmp_ps(len2, tiny2, _CMP_GT_OQ);
+  __m256 y = _mm256_rsqrt_ps(len2);
+  y = _mm256_mul_ps(_mm256_mul_ps(half, y), _mm256_sub_ps(three, _mm256_mul_ps(len2, _mm256_mul_ps(y, y))));
+  const __m256 r = _mm256_loadu_ps(rest);
+  __m256 s;
+  if (kKind != Kind::Equality) {
+    const __m256 c = _mm256_max_ps(_mm256_sub_ps(_mm256_mul_ps(len2, y), _mm256_mul_ps(r, vscale)), zero);
+    // Most tethers, and nearly every edge against the strain limit, are slack (inactive
+    // inequalities): when every lane's violation is zero and its d finite, the stores would
+    // write back what was read; skip them (same bits), before inv_w is read. A lane whose
+    // correction comes out zero anyway (inv_w 0: both ends pinned) writes back its own bits.
+    const __m256 acts = _mm256_or_ps(_mm256_cmp_ps(_mm256_and_ps(ok, c), zero, _CMP_NEQ_UQ),
+                                     _mm256_cmp_ps(len2, inf, _CMP_NLT_UQ));
+    if (_mm256_movemask_ps(acts) == 0) return;
+    s = _mm256_mul_ps(_mm256_mul_ps(c, y), _mm256_loadu_ps(inv_w));
+  } else {
+    s = _mm256_mul_ps(_mm256_sub_ps(one, _mm256_mul_ps(r, y)), _mm256_loadu_ps(inv_w));
   }
+  s = _mm256_and_ps(ok, s);
+  const __m256 sa = _mm256_mul_ps(aw, s);
+  ax = _mm256_sub_ps(ax, _mm256_mul_ps(sa, dx));
+  ay = _mm256_sub_ps(ay, _mm256_mul_ps(sa, dy));
+  az = _mm256_sub_ps(az, _mm256_mul_ps(sa, dz));
+  scatter8<kQuads>(x, A, ax, ay, az, aw);
+  if (kKind != Kind::Tether) {
+    const __m256 sb = _mm256_mul_ps(bw, s);
+    bx = _mm256_add_ps(bx, _mm256_mul_ps(sb, dx));
+    by = _mm256_add_ps(by, _mm256_mul_ps(sb, dy));
+    bz = _mm256_add_ps(bz, _mm256_mul_ps(sb, dz));
+    scatter8<kQuads>(x, B, bx, by, bz, bw);
+  }
+}
+
+// Entries [first, m) of the lists, quad runs as projectBatchesAvx512.
+template <Kind kKind>
+__attribute__((target("avx"))) void projectBatchesAvx(Vec4* x, const uint32_t* A, const uint32_t* B,
+                                                      const float* rest, const float* inv_w, size_t first,
+                                                      size_t m, float scale,
+                                                      const std::pair<uint32_t, uint32_t>* quad_runs,
+                                                      size_t run_count) {
+  const __m256 vscale = _mm256_set1_ps(scale);
+  size_t k = first;
+  for (size_t r = 0; r < run_count; ++r) {
+    if (quad_runs[r].first < first) continue;
+    for (; k < quad_runs[r].first; k += 8)
+      projectBatch8<kKind, false>(x, A + k, B + k, rest + k, inv_w + k, vscale);
+    for (; k < quad_runs[r].second; k += 8)
+      projectBatch8<kKind, true>(x, A + k, B + k, rest + k, inv_w + k, vscale);
+  }
+  for (; k < m; k += 8) projectBatch8<kKind, false>(x, A + k, B + k, rest + k, inv_w + k, vscale);
 }
 #endif
 
@@ -257,16 +336,21 @@ DRAPE_AVX512_FN __attribute__((always_inline)) inline __m512 quad16(Vec4* x, con
   r = _mm512_insertf32x4(r, _mm_load_ps(at(x, off[i + 8])), 2);
   return _mm512_insertf32x4(r, _mm_load_ps(at(x, off[i + 12])), 3);
 }
+// kQuads: the batch is a quad batch (Batches::quad_runs), lanes i, i + 4, i + 8, i + 12 four
+// consecutive particles from off[i]: one 64-byte load (store) instead of four 16-byte ones.
+template <bool kQuads>
 DRAPE_AVX512_FN __attribute__((always_inline)) inline void gather16(Vec4* x, const uint32_t* off, __m512& px,
                                                                     __m512& py, __m512& pz, __m512& pw) {
-  const __m512 r0 = quad16(x, off, 0), r1 = quad16(x, off, 1), r2 = quad16(x, off, 2), r3 = quad16(x, off, 3);
-  const __m512 t0 = _mm512_unpacklo_ps(r0, r1), t1 = _mm512_unpackhi_ps(r0, r1);
-  const __m512 t2 = _mm512_unpacklo_ps(r2, r3), t3 = _mm512_unpackhi_ps(r2, r3);
+  __m512 r[4];
+  for (int i = 0; i < 4; ++i) r[i] = kQuads ? _mm512_loadu_ps(at(x, off[i])) : quad16(x, off, i);
+  const __m512 t0 = _mm512_unpacklo_ps(r[0], r[1]), t1 = _mm512_unpackhi_ps(r[0], r[1]);
+  const __m512 t2 = _mm512_unpacklo_ps(r[2], r[3]), t3 = _mm512_unpackhi_ps(r[2], r[3]);
   px = _mm512_shuffle_ps(t0, t2, 0x44);
   py = _mm512_shuffle_ps(t0, t2, 0xEE);
   pz = _mm512_shuffle_ps(t1, t3, 0x44);
   pw = _mm512_shuffle_ps(t1, t3, 0xEE);
 }
+template <bool kQuads>
 DRAPE_AVX512_FN __attribute__((always_inline)) inline void scatter16(Vec4* x, const uint32_t* off, __m512 px,
                                                                      __m512 py, __m512 pz, __m512 pw) {
   const __m512 t0 = _mm512_unpacklo_ps(px, py), t1 = _mm512_unpackhi_ps(px, py);
@@ -274,6 +358,10 @@ DRAPE_AVX512_FN __attribute__((always_inline)) inline void scatter16(Vec4* x, co
   const __m512 r[4] = {_mm512_shuffle_ps(t0, t2, 0x44), _mm512_shuffle_ps(t0, t2, 0xEE),
                        _mm512_shuffle_ps(t1, t3, 0x44), _mm512_shuffle_ps(t1, t3, 0xEE)};
   for (int i = 0; i < 4; ++i) {
+    if (kQuads) {
+      _mm512_storeu_ps(at(x, off[i]), r[i]);
+      continue;
+    }
     _mm_store_ps(at(x, off[i]), _mm512_castps512_ps128(r[i]));
     _mm_store_ps(at(x, off[i + 4]), _mm512_extractf32x4_ps(r[i], 1));
     _mm_store_ps(at(x, off[i + 8]), _mm512_extractf32x4_ps(r[i], 2));
@@ -287,49 +375,67 @@ DRAPE_AVX512_FN __attribute__((always_inline)) inline __m512 rsqrtAsAvx(__m512 v
   return _mm512_castpd_ps(_mm512_insertf64x4(_mm512_castps_pd(_mm512_castps256_ps512(lo)), _mm256_castps_pd(hi), 1));
 }
 
-template <Kind kKind>
-DRAPE_AVX512_FN void projectBatchesAvx512(Vec4* x, const uint32_t* A, const uint32_t* B, const float* rest,
-                                          const float* inv_w, size_t m, float scale) {
-  const __m512 vscale = _mm512_set1_ps(scale), zero = _mm512_setzero_ps();
+// One batch of 16 constraints (entries A[0..16), ...).
+template <Kind kKind, bool kQuads>
+DRAPE_AVX512_FN __attribute__((always_inline)) inline void projectBatch16(Vec4* x, const uint32_t* A,
+                                                                          const uint32_t* B, const float* rest,
+                                                                          const float* inv_w, __m512 vscale) {
+  const __m512 zero = _mm512_setzero_ps();
   const __m512 tiny2 = _mm512_set1_ps(1e-18f), half = _mm512_set1_ps(0.5f);
   const __m512 three = _mm512_set1_ps(3.0f), one = _mm512_set1_ps(1.0f);
   const __m512 inf = _mm512_set1_ps(std::numeric_limits<float>::infinity());
-  for (size_t k = 0; k < m; k += 16) {
-    __m512 ax, ay, az, aw, bx, by, bz, bw;
-    gather16(x, A + k, ax, ay, az, aw);
-    gather16(x, B + k, bx, by, bz, bw);
-    const __m512 dx = _mm512_sub_ps(ax, bx), dy = _mm512_sub_ps(ay, by), dz = _mm512_sub_ps(az, bz);
-    const __m512 len2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)),
-                                      _mm512_mul_ps(dz, dz));
-    const __mmask16 ok = _mm512_cmp_ps_mask(len2, tiny2, _CMP_GT_OQ);
-    __m512 y = rsqrtAsAvx(len2);
-    y = _mm512_mul_ps(_mm512_mul_ps(half, y), _mm512_sub_ps(three, _mm512_mul_ps(len2, _mm512_mul_ps(y, y))));
-    const __m512 r = _mm512_loadu_ps(rest + k);
-    __m512 s;
-    if (kKind != Kind::Equality) {
-      const __m512 c = _mm512_max_ps(_mm512_sub_ps(_mm512_mul_ps(len2, y), _mm512_mul_ps(r, vscale)), zero);
-      // As the AVX kernel: a batch of slack inequalities (and finite d) writes nothing.
-      const __mmask16 acts = _mm512_cmp_ps_mask(_mm512_maskz_mov_ps(ok, c), zero, _CMP_NEQ_UQ) |
-                             _mm512_cmp_ps_mask(len2, inf, _CMP_NLT_UQ);
-      if (acts == 0) continue;
-      s = _mm512_mul_ps(_mm512_mul_ps(c, y), _mm512_loadu_ps(inv_w + k));
-    } else {
-      s = _mm512_mul_ps(_mm512_sub_ps(one, _mm512_mul_ps(r, y)), _mm512_loadu_ps(inv_w + k));
-    }
-    s = _mm512_maskz_mov_ps(ok, s);  // +0 where |d| is too small, as the AVX kernel's _mm256_and_ps
-    const __m512 sa = _mm512_mul_ps(aw, s);
-    ax = _mm512_sub_ps(ax, _mm512_mul_ps(sa, dx));
-    ay = _mm512_sub_ps(ay, _mm512_mul_ps(sa, dy));
-    az = _mm512_sub_ps(az, _mm512_mul_ps(sa, dz));
-    scatter16(x, A + k, ax, ay, az, aw);
-    if (kKind != Kind::Tether) {
-      const __m512 sb = _mm512_mul_ps(bw, s);
-      bx = _mm512_add_ps(bx, _mm512_mul_ps(sb, dx));
-      by = _mm512_add_ps(by, _mm512_mul_ps(sb, dy));
-      bz = _mm512_add_ps(bz, _mm512_mul_ps(sb, dz));
-      scatter16(x, B + k, bx, by, bz, bw);
-    }
+  __m512 ax, ay, az, aw, bx, by, bz, bw;
+  gather16<kQuads>(x, A, ax, ay, az, aw);
+  gather16<kQuads>(x, B, bx, by, bz, bw);
+  const __m512 dx = _mm512_sub_ps(ax, bx), dy = _mm512_sub_ps(ay, by), dz = _mm512_sub_ps(az, bz);
+  const __m512 len2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)),
+                                    _mm512_mul_ps(dz, dz));
+  const __mmask16 ok = _mm512_cmp_ps_mask(len2, tiny2, _CMP_GT_OQ);
+  __m512 y = rsqrtAsAvx(len2);
+  y = _mm512_mul_ps(_mm512_mul_ps(half, y), _mm512_sub_ps(three, _mm512_mul_ps(len2, _mm512_mul_ps(y, y))));
+  const __m512 r = _mm512_loadu_ps(rest);
+  __m512 s;
+  if (kKind != Kind::Equality) {
+    const __m512 c = _mm512_max_ps(_mm512_sub_ps(_mm512_mul_ps(len2, y), _mm512_mul_ps(r, vscale)), zero);
+    // As the AVX kernel: a batch of slack inequalities (and finite d) writes nothing.
+    const __mmask16 acts = _mm512_cmp_ps_mask(_mm512_maskz_mov_ps(ok, c), zero, _CMP_NEQ_UQ) |
+                           _mm512_cmp_ps_mask(len2, inf, _CMP_NLT_UQ);
+    if (acts == 0) return;
+    s = _mm512_mul_ps(_mm512_mul_ps(c, y), _mm512_loadu_ps(inv_w));
+  } else {
+    s = _mm512_mul_ps(_mm512_sub_ps(one, _mm512_mul_ps(r, y)), _mm512_loadu_ps(inv_w));
   }
+  s = _mm512_maskz_mov_ps(ok, s);  // +0 where |d| is too small, as the AVX kernel's _mm256_and_ps
+  const __m512 sa = _mm512_mul_ps(aw, s);
+  ax = _mm512_sub_ps(ax, _mm512_mul_ps(sa, dx));
+  ay = _mm512_sub_ps(ay, _mm512_mul_ps(sa, dy));
+  az = _mm512_sub_ps(az, _mm512_mul_ps(sa, dz));
+  scatter16<kQuads>(x, A, ax, ay, az, aw);
+  if (kKind != Kind::Tether) {
+    const __m512 sb = _mm512_mul_ps(bw, s);
+    bx = _mm512_add_ps(bx, _mm512_mul_ps(sb, dx));
+    by = _mm512_add_ps(by, _mm512_mul_ps(sb, dy));
+    bz = _mm512_add_ps(bz, _mm512_mul_ps(sb, dz));
+    scatter16<kQuads>(x, B, bx, by, bz, bw);
+  }
+}
+
+// Entries [first, m) of the lists; quad_runs (Batches::quad_runs, sorted, each within one colour
+// group, so each lies wholly before or after `first`, a group's start) take the 64-byte path.
+template <Kind kKind>
+DRAPE_AVX512_FN void projectBatchesAvx512(Vec4* x, const uint32_t* A, const uint32_t* B, const float* rest,
+                                          const float* inv_w, size_t first, size_t m, float scale,
+                                          const std::pair<uint32_t, uint32_t>* quad_runs, size_t run_count) {
+  const __m512 vscale = _mm512_set1_ps(scale);
+  size_t k = first;
+  for (size_t r = 0; r < run_count; ++r) {
+    if (quad_runs[r].first < first) continue;
+    for (; k < quad_runs[r].first; k += 16)
+      projectBatch16<kKind, false>(x, A + k, B + k, rest + k, inv_w + k, vscale);
+    for (; k < quad_runs[r].second; k += 16)
+      projectBatch16<kKind, true>(x, A + k, B + k, rest + k, inv_w + k, vscale);
+  }
+  for (; k < m; k += 16) projectBatch16<kKind, false>(x, A + k, B + k, rest + k, inv_w + k, vscale);
 }
 #if !defined(__clang__)
 #pragma GCC diagnostic pop
@@ -342,18 +448,19 @@ DRAPE_AVX512_FN void projectBatchesAvx512(Vec4* x, const uint32_t* A, const uint
 template <Kind kKind>
 void project(Vec4* x, const std::vector<uint32_t>& A, const std::vector<uint32_t>& B,
              const std::vector<uint32_t>& A_off, const std::vector<uint32_t>& B_off, const float* rest,
-             const float* inv_w, float scale, size_t first = 0, bool wide = true) {
+             const float* inv_w, float scale, const std::vector<std::pair<uint32_t, uint32_t>>& quad_runs,
+             size_t first = 0, bool wide = true) {
   const size_t m = A.size();
   if (first >= m) return;
 #if DRAPE_XPBD_AVX
   if (wide && cpuHasAvx512() && A_off.size() == m && B_off.size() == m)
-    return projectBatchesAvx512<kKind>(x, A_off.data() + first, B_off.data() + first, rest + first,
-                                       inv_w + first, m - first, scale);
+    return projectBatchesAvx512<kKind>(x, A_off.data(), B_off.data(), rest, inv_w, first, m, scale,
+                                       quad_runs.data(), quad_runs.size());
   if (cpuHasAvx() && A_off.size() == m && B_off.size() == m)
-    return projectBatchesAvx<kKind>(x, A_off.data() + first, B_off.data() + first, rest + first,
-                                    inv_w + first, m - first, scale);
+    return projectBatchesAvx<kKind>(x, A_off.data(), B_off.data(), rest, inv_w, first, m, scale,
+                                    quad_runs.data(), quad_runs.size());
 #endif
-  (void)A_off, (void)B_off, (void)wide;
+  (void)A_off, (void)B_off, (void)wide, (void)quad_runs;
   projectBatches<kKind>(x, A.data() + first, B.data() + first, rest + first, inv_w + first, m - first, scale);
 }
 
@@ -470,10 +577,10 @@ void XpbdSolver::buildBatches() {
   for (uint8_t k : kDistanceKindOrder) {
     if (k == 0) stretch_first_ = distance_.a.size();  // where the stretch colour groups start
     appendPadded(*kinds[k], 0.0f, dummy, &distance_kind_, k, distance_.a, distance_.b,
-                 distance_.rest, distance_.compliance, distance_.group_offsets);
+                 distance_.rest, distance_.compliance, distance_.group_offsets, distance_.quad_runs);
   }
   appendPadded(topology_.tether, 0.0f, dummy, nullptr, 0, tethers_.a, tethers_.b,
-               tethers_.rest, tethers_.compliance, tethers_.group_offsets);
+               tethers_.rest, tethers_.compliance, tethers_.group_offsets, tethers_.quad_runs);
   // The inverse masses are the topology's and never change (reset restores them), so their pair
   // sums are fixed with the batches; the dummy particle weighs nothing (w = 0).
   auto w = [&](uint32_t i) { return i < dummy ? topology_.inverse_mass[i] : 0.0f; };
@@ -712,9 +819,10 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
   }
   for (int it = 0; it < p.iterations; ++it) {  // 1 by default: the method's single pass
     project<Kind::Equality>(x, distance_.a, distance_.b, distance_.a_off, distance_.b_off,
-                            distance_.rest.data(), distance_.inv_w.data(), 1.0f, 0, wide_projection_);
+                            distance_.rest.data(), distance_.inv_w.data(), 1.0f, distance_.quad_runs, 0,
+                            wide_projection_);
     project<Kind::Tether>(x, tethers_.a, tethers_.b, tethers_.a_off, tethers_.b_off, tethers_.rest.data(),
-                          tethers_.inv_w.data(), p.tether_scale, 0, wide_projection_);
+                          tethers_.inv_w.data(), p.tether_scale, tethers_.quad_runs, 0, wide_projection_);
   }
   // The strain limit (XpbdParams::strain_limit) on the step's last substep, before collision so
   // that no particle is left inside an ellipsoid.
@@ -722,7 +830,8 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
   if (!predict_next && p.strain_limit > 0.0f) {
     for (int pass = 0; pass < p.strain_limit_passes; ++pass)
       project<Kind::Limit>(x, distance_.a, distance_.b, distance_.a_off, distance_.b_off, distance_.rest.data(),
-                           distance_.inv_w.data(), 1.0f + p.strain_limit, stretch_first_, wide_projection_);
+                           distance_.inv_w.data(), 1.0f + p.strain_limit, distance_.quad_runs, stretch_first_,
+                           wide_projection_);
   }
   // 3. Collision against the tracking ellipsoids.
   if (collider != nullptr) {

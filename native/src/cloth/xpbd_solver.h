@@ -146,15 +146,7 @@ class XpbdSolver {
   void setWideProjection(bool on) { wide_projection_ = on; }
   const XpbdTimings& lastTimings() const { return timings_; }
 
- private:
-  // pin_t: fraction of the step at the substep end; collider: this substep's, or null.
-  // span_prev: positions at the start of the collision span (the substep start when stride 1).
-  // predicted: the prediction already ran (fused into the previous substep's last loop);
-  // predict_next: run the next substep's prediction in this one's last loop (same step, same h),
-  // with each particle's position before it copied to capture[i] when capture is not null.
-  void substep(float h, float pin_t, const EllipsoidCollider* collider, const Eigen::Vector4f* span_prev,
-               bool predicted, bool predict_next, Eigen::Vector4f* capture);
-  // Constraint storage for the SIMD kernels: every colour group padded to a multiple of kLanes
+  // Constraint storage for the SIMD kernels: every colour group padded to a multiple of kLanes (16)
   // with dummy constraints on the dummy particle x_[n] (w = 0, never read back), so a batch of
   // kLanes constraints shares no particle and needs no tail loop. Stretch, shear and bend are
   // one list (their colour groups concatenated in kDistanceKindOrder: the same Gauss–Seidel
@@ -170,7 +162,24 @@ class XpbdSolver {
     // others, rigid constraints and padding, are set once by refreshCompliance)
     std::vector<std::pair<uint32_t, uint32_t>> compliant;
     std::vector<uint32_t> group_offsets{0};
+    // [begin, end) runs of whole batches of kLanes (16) whose lanes q, q + 4, q + 8, q + 12 are
+    // four consecutive particles at both ends (quadOrder in xpbd_solver.cpp): the AVX-512 kernel
+    // moves each such quad as one 64-byte load and store instead of four 16-byte ones, the AVX
+    // kernel each half as one 32-byte one.
+    std::vector<std::pair<uint32_t, uint32_t>> quad_runs;
   };
+  // The lists as the kernels run them (tests check their layout).
+  const Batches& distanceBatches() const { return distance_; }
+  const Batches& tetherBatches() const { return tethers_; }
+
+ private:
+  // pin_t: fraction of the step at the substep end; collider: this substep's, or null.
+  // span_prev: positions at the start of the collision span (the substep start when stride 1).
+  // predicted: the prediction already ran (fused into the previous substep's last loop);
+  // predict_next: run the next substep's prediction in this one's last loop (same step, same h),
+  // with each particle's position before it copied to capture[i] when capture is not null.
+  void substep(float h, float pin_t, const EllipsoidCollider* collider, const Eigen::Vector4f* span_prev,
+               bool predicted, bool predict_next, Eigen::Vector4f* capture);
   void buildBatches();
   void refreshCompliance();  // after setParams
 
