@@ -39,11 +39,13 @@ double nsBetween(Clock::time_point a, Clock::time_point b) {
 // `*quad_batches` batches of kLanes whose lanes q, q + 4, q + 8, q + 12 hold four constraints
 // (a, b), (a + 1, b + 1), (a + 2, b + 2), (a + 3, b + 3) (a "quad": both ends four consecutive
 // particles, as a template's rows of edges are), for q = 0..3; then the rest in the colour's order.
+// quad_b false (tethers, whose b is an anchor the kernels only read): a quad needs consecutive a
+// alone.
 // Within a colour no two constraints share a particle that either writes, so this order gives the
 // same bits as any other; it lets the AVX-512 kernel load and store a quad's four particles as one
 // 64-byte vector (QuadRuns).
 std::vector<uint32_t> quadOrder(const DistanceConstraints& c, uint32_t g0, uint32_t g1, uint32_t particles,
-                                std::vector<int32_t>& entry_of_a, size_t* quad_batches) {
+                                bool quad_b, std::vector<int32_t>& entry_of_a, size_t* quad_batches) {
   std::vector<uint32_t> by_a(g1 - g0);
   for (uint32_t k = g0; k < g1; ++k) by_a[k - g0] = k;
   std::sort(by_a.begin(), by_a.end(), [&](uint32_t i, uint32_t j) { return c.a[i] < c.a[j]; });
@@ -58,7 +60,8 @@ std::vector<uint32_t> quadOrder(const DistanceConstraints& c, uint32_t g0, uint3
     for (uint32_t j = 1; j < 4 && quad; ++j) {
       const uint32_t aj = c.a[k] + j;
       const int32_t ej = aj < particles ? entry_of_a[aj] : -1;
-      quad = ej >= 0 && !used[static_cast<uint32_t>(ej) - g0] && c.b[static_cast<uint32_t>(ej)] == c.b[k] + j;
+      quad = ej >= 0 && !used[static_cast<uint32_t>(ej) - g0] &&
+             (!quad_b || c.b[static_cast<uint32_t>(ej)] == c.b[k] + j);
       if (quad) e[j] = static_cast<uint32_t>(ej);
     }
     if (!quad) continue;
@@ -86,7 +89,7 @@ std::vector<uint32_t> quadOrder(const DistanceConstraints& c, uint32_t g0, uint3
 // Appends the colour groups of `c` to `out`, each padded to a multiple of kLanes with dummy
 // constraints on particle `dummy` (= the particle count), each in quadOrder, with the entries of
 // its quad batches added to `quad_runs` ([begin, end) ranges).
-void appendPadded(const DistanceConstraints& c, float compliance, uint32_t dummy,
+void appendPadded(const DistanceConstraints& c, bool quad_b, float compliance, uint32_t dummy,
                   std::vector<uint8_t>* kinds, uint8_t kind,
                   std::vector<uint32_t>& a, std::vector<uint32_t>& b, std::vector<float>& rest,
                   std::vector<float>& comp, std::vector<uint32_t>& offsets,
@@ -95,7 +98,8 @@ void appendPadded(const DistanceConstraints& c, float compliance, uint32_t dummy
   for (size_t g = 0; g < c.colours(); ++g) {
     size_t quad_batches = 0;
     const uint32_t start = static_cast<uint32_t>(a.size());
-    for (uint32_t k : quadOrder(c, c.colour_offsets[g], c.colour_offsets[g + 1], dummy, entry_of_a, &quad_batches)) {
+    for (uint32_t k :
+         quadOrder(c, c.colour_offsets[g], c.colour_offsets[g + 1], dummy, quad_b, entry_of_a, &quad_batches)) {
       a.push_back(c.a[k]);
       b.push_back(c.b[k]);
       rest.push_back(c.rest[k]);
@@ -253,7 +257,7 @@ __attribute__((target("avx"), always_inline)) inline void projectBatch8(Vec4* x,
   const __m256 inf = _mm256_set1_ps(std::numeric_limits<float>::infinity());
   __m256 ax, ay, az, aw, bx, by, bz, bw;
   gather8<kQuads>(x, A, ax, ay, az, aw);
-  gather8<kQuads>(x, B, bx, by, bz, bw);
+  gather8<kQuads && kKind != Kind::Tether>(x, B, bx, by, bz, bw);  // a tether's quad is its a side
   const __m256 dx = _mm256_sub_ps(ax, bx), dy = _mm256_sub_ps(ay, by), dz = _mm256_sub_ps(az, bz);
   const __m256 len2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
                                     _mm256_mul_ps(dz, dz));
@@ -386,7 +390,7 @@ DRAPE_AVX512_FN __attribute__((always_inline)) inline void projectBatch16(Vec4* 
   const __m512 inf = _mm512_set1_ps(std::numeric_limits<float>::infinity());
   __m512 ax, ay, az, aw, bx, by, bz, bw;
   gather16<kQuads>(x, A, ax, ay, az, aw);
-  gather16<kQuads>(x, B, bx, by, bz, bw);
+  gather16<kQuads && kKind != Kind::Tether>(x, B, bx, by, bz, bw);  // a tether's quad is its a side
   const __m512 dx = _mm512_sub_ps(ax, bx), dy = _mm512_sub_ps(ay, by), dz = _mm512_sub_ps(az, bz);
   const __m512 len2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)),
                                     _mm512_mul_ps(dz, dz));
@@ -576,10 +580,10 @@ void XpbdSolver::buildBatches() {
   const DistanceConstraints* kinds[3] = {&topology_.stretch, &topology_.shear, &topology_.bend};
   for (uint8_t k : kDistanceKindOrder) {
     if (k == 0) stretch_first_ = distance_.a.size();  // where the stretch colour groups start
-    appendPadded(*kinds[k], 0.0f, dummy, &distance_kind_, k, distance_.a, distance_.b,
+    appendPadded(*kinds[k], true, 0.0f, dummy, &distance_kind_, k, distance_.a, distance_.b,
                  distance_.rest, distance_.compliance, distance_.group_offsets, distance_.quad_runs);
   }
-  appendPadded(topology_.tether, 0.0f, dummy, nullptr, 0, tethers_.a, tethers_.b,
+  appendPadded(topology_.tether, false, 0.0f, dummy, nullptr, 0, tethers_.a, tethers_.b,
                tethers_.rest, tethers_.compliance, tethers_.group_offsets, tethers_.quad_runs);
   // The inverse masses are the topology's and never change (reset restores them), so their pair
   // sums are fixed with the batches; the dummy particle weighs nothing (w = 0).

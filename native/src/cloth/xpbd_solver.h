@@ -163,9 +163,9 @@ class XpbdSolver {
     std::vector<std::pair<uint32_t, uint32_t>> compliant;
     std::vector<uint32_t> group_offsets{0};
     // [begin, end) runs of whole batches of kLanes (16) whose lanes q, q + 4, q + 8, q + 12 are
-    // four consecutive particles at both ends (quadOrder in xpbd_solver.cpp): the AVX-512 kernel
-    // moves each such quad as one 64-byte load and store instead of four 16-byte ones, the AVX
-    // kernel each half as one 32-byte one.
+    // four consecutive particles at both ends (tethers: at the free end a; quadOrder in
+    // xpbd_solver.cpp): the AVX-512 kernel moves each such quad as one 64-byte load and store
+    // instead of four 16-byte ones, the AVX kernel each half as one 32-byte one.
     std::vector<std::pair<uint32_t, uint32_t>> quad_runs;
   };
   // The lists as the kernels run them (tests check their layout).
