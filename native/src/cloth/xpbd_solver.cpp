@@ -511,6 +511,53 @@ __attribute__((target("avx"))) size_t fusedPairsAvx(Vec4* x, Vec4* prev, Vec4* v
   return i;
 }
 
+#if !defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+// squaredNorms2 for four particles (one per 128-bit lane).
+DRAPE_AVX512_FN __attribute__((always_inline)) inline __m512 squaredNorms4(__m512 a) {
+  const __m512 t = _mm512_mul_ps(a, a);
+  const __m512 u = _mm512_add_ps(t, _mm512_permute_ps(t, _MM_SHUFFLE(1, 0, 3, 2)));
+  return _mm512_add_ps(u, _mm512_permute_ps(u, _MM_SHUFFLE(2, 3, 0, 1)));
+}
+// fusedPairsAvx four particles at a time (AVX-512F): the same operations per lane, so the same
+// bits. Returns where it stopped: the first particle of a quad the speed clamp would act on, or
+// where fewer than four are left (the caller goes on with fusedPairsAvx from there).
+DRAPE_AVX512_FN size_t fusedQuadsAvx512(Vec4* x, Vec4* prev, Vec4* vel, Vec4* capture, size_t i, size_t n,
+                                        float scale, const Vec4& hg, const Vec4& wind, float h_drag, float h,
+                                        float max_speed2) {
+  const __m512 vscale = _mm512_set1_ps(scale), vh = _mm512_set1_ps(h), vdrag = _mm512_set1_ps(h_drag);
+  const __m512 vhg = _mm512_broadcast_f32x4(_mm_loadu_ps(hg.data()));
+  const __m512 vwind = _mm512_broadcast_f32x4(_mm_loadu_ps(wind.data()));
+  const __m512 limit = _mm512_set1_ps(max_speed2), zero = _mm512_setzero_ps();
+  const bool clamp = max_speed2 > 0.0f;
+  for (; i + 4 <= n; i += 4) {
+    const __m512 xi = _mm512_loadu_ps(x[i].data());
+    const __m512 v = _mm512_mul_ps(_mm512_sub_ps(xi, _mm512_loadu_ps(prev[i].data())), vscale);
+    const __m512 vp = _mm512_add_ps(v, _mm512_add_ps(vhg, _mm512_mul_ps(vdrag, _mm512_sub_ps(vwind, v))));
+    if (clamp && (_mm512_cmp_ps_mask(squaredNorms4(v), limit, _CMP_GT_OQ) |
+                  _mm512_cmp_ps_mask(squaredNorms4(vp), limit, _CMP_GT_OQ)))
+      return i;
+    // Pinned particles (w = 0) keep their position and the first velocity: each particle's w
+    // lane's bit (3, 7, 11, 15) spread to its four lanes.
+    unsigned pinned = _mm512_cmp_ps_mask(xi, zero, _CMP_EQ_OQ) & 0x8888u;
+    pinned |= pinned >> 1;
+    pinned |= pinned >> 2;
+    const __mmask16 keep = static_cast<__mmask16>(pinned);
+    if (capture) _mm512_storeu_ps(capture[i].data(), xi);
+    _mm512_storeu_ps(prev[i].data(), xi);
+    _mm512_storeu_ps(vel[i].data(), _mm512_mask_blend_ps(keep, vp, v));
+    const __m512 moved = _mm512_add_ps(xi, _mm512_mul_ps(vh, vp));
+    _mm512_storeu_ps(x[i].data(), _mm512_mask_blend_ps(keep, moved, xi));
+  }
+  return i;
+}
+#if !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
+
 // c0 d.x + (c1 d.y + c2 d.z) for each 128-bit half's d (c0..c2: a 3 x 3 matrix's columns), the
 // order Eigen's unrolled sum of three products takes (it splits a length-3 sum as 1 + 2).
 __attribute__((target("avx"), always_inline)) inline __m256 rotatePair(__m256 c0, __m256 c1, __m256 c2, __m256 d) {
@@ -873,9 +920,12 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
   };
   size_t i = 0;
 #if DRAPE_XPBD_AVX
-  // Two particles at a time where the CPU has AVX; a pair the speed clamp acts on (rare) and an
-  // odd last particle go the scalar way.
+  // Four particles at a time where the CPU has AVX-512F, two where it has AVX; a pair the speed
+  // clamp acts on (rare) and an odd last particle go the scalar way. (After a quad the clamp acts
+  // on, the rest of the substep goes by pairs: simpler, and the clamp is rare.)
   if (predict_next && paired_update_ && cpuHasAvx()) {
+    if (wide_projection_ && cpuHasAvx512())
+      i = fusedQuadsAvx512(x, prev, vel, capture, i, n, scale, hg, wind, h_drag, h, max_speed2);
     while ((i = fusedPairsAvx(x, prev, vel, capture, i, n, scale, hg, wind, h_drag, h, max_speed2)) < n) {
       const size_t stop = std::min(n, i + 2);
       for (; i < stop; ++i) update(i);
