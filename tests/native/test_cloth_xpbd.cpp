@@ -240,8 +240,9 @@ TEST(ClothXpbd, WideProjectionMatchesEightLanesBitForBit) {
 // The projection's lists (XpbdSolver::Batches) hold every constraint of the topology once, in
 // colour groups padded to 16 with dummies, and every batch of a quad run has in lanes q, q + 4,
 // q + 8, q + 12 four consecutive particles at both ends (tethers: at the free end; what the
-// kernels load as one vector), within one colour group. On this grid 1 360 of the 3 174 distance constraints are in quad
-// batches (edges along a row pair up with their neighbours' only every other one, in two colours).
+// kernels load as one vector), within one colour group. On this grid 1 360 of the 3 174 distance
+// constraints are in quad batches (edges along a row pair up with their neighbours' only every
+// other one, in two colours), and most tethers.
 TEST(ClothXpbd, QuadBatchesHoldEveryConstraintOnceAndFourConsecutiveParticles) {
   const GarmentTopology topology = square(24, false);
   const XpbdSolver s(topology);

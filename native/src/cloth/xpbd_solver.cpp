@@ -35,7 +35,7 @@ double nsBetween(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::nano>(b - a).count();
 }
 
-// The entries [g0, g1) of colour group `g` of `c` in the order appendPadded stores them: first
+// The entries [g0, g1) of one colour group of `c` in the order appendPadded stores them: first
 // `*quad_batches` batches of kLanes whose lanes q, q + 4, q + 8, q + 12 hold four constraints
 // (a, b), (a + 1, b + 1), (a + 2, b + 2), (a + 3, b + 3) (a "quad": both ends four consecutive
 // particles, as a template's rows of edges are), for q = 0..3; then the rest in the colour's order.
@@ -43,7 +43,7 @@ double nsBetween(Clock::time_point a, Clock::time_point b) {
 // alone.
 // Within a colour no two constraints share a particle that either writes, so this order gives the
 // same bits as any other; it lets the AVX-512 kernel load and store a quad's four particles as one
-// 64-byte vector (QuadRuns).
+// 64-byte vector (Batches::quad_runs).
 std::vector<uint32_t> quadOrder(const DistanceConstraints& c, uint32_t g0, uint32_t g1, uint32_t particles,
                                 bool quad_b, std::vector<int32_t>& entry_of_a, size_t* quad_batches) {
   std::vector<uint32_t> by_a(g1 - g0);

@@ -141,8 +141,9 @@ class XpbdSolver {
   // On by default where the CPU has AVX: the per-substep velocity update and prediction two
   // particles at a time (the same bits as one at a time). Off: one at a time (tests compare).
   void setPairedUpdate(bool on) { paired_update_ = on; }
-  // On by default where the CPU has AVX-512F: constraints projected 16 at a time (the same bits as
-  // 8 or 4 at a time). Off: the AVX (or SSE) kernel (tests compare).
+  // On by default where the CPU has AVX-512F: constraints projected 16 at a time, and the fused
+  // velocity update four particles at a time (the same bits as 8, 4 or 2 at a time). Off: the AVX
+  // (or SSE) kernels (tests compare).
   void setWideProjection(bool on) { wide_projection_ = on; }
   const XpbdTimings& lastTimings() const { return timings_; }
 

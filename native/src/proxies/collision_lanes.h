@@ -1,5 +1,5 @@
-// Internal to the ellipsoid collider's batched pass 0 (collision_batch.inc, compiled as eight
-// lanes with AVX in collision_eight.cpp and as sixteen with AVX-512F in collision_sixteen.cpp):
+// Internal to the ellipsoid collider's batched pass 0 (collision_batch.inc, compiled in
+// collision_batch.cpp as eight lanes with AVX and as sixteen with AVX-512F):
 // two namespaces, lanes8 and lanes16, with the same helpers, so one body serves both widths. Each
 // helper reproduces the scalar path's arithmetic lane by lane (Eigen's summation orders, no FMA),
 // so that a batch gives the one-particle results bit for bit. Only for functions compiled with
