@@ -24,12 +24,6 @@ using collision_lanes::orCells;
 #define DRAPE_BATCH_SETTLE settleEight
 #define DRAPE_BATCH_EXACT exactContactsEight
 #include "proxies/collision_batch.inc"
-#undef DRAPE_BATCH_LANES
-#undef DRAPE_BATCH_TARGET
-#undef DRAPE_BATCH_CPU
-#undef DRAPE_BATCH_COLLIDE
-#undef DRAPE_BATCH_SETTLE
-#undef DRAPE_BATCH_EXACT
 
 #if !defined(__clang__)
 // GCC 12's AVX-512 intrinsics pass _mm512_undefined_ps() (a self-initialised variable) as the
@@ -45,12 +39,6 @@ using collision_lanes::orCells;
 #define DRAPE_BATCH_SETTLE settleSixteen
 #define DRAPE_BATCH_EXACT exactContactsSixteen
 #include "proxies/collision_batch.inc"
-#undef DRAPE_BATCH_LANES
-#undef DRAPE_BATCH_TARGET
-#undef DRAPE_BATCH_CPU
-#undef DRAPE_BATCH_COLLIDE
-#undef DRAPE_BATCH_SETTLE
-#undef DRAPE_BATCH_EXACT
 #if !defined(__clang__)
 #pragma GCC diagnostic pop
 #endif
