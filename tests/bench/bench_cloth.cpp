@@ -104,8 +104,10 @@ BENCHMARK(BM_ClothMassSpringFrame)
 // One cloth step per recording frame at 1/30 s, 10 substeps, collision against the ~137 Drape
 // ellipsoids interpolated across the substeps. Times setPinTargets + setColliderMotion + step.
 // Counters: ns per particle per substep, total and split (constraints = predict, XPBD projection
-// and velocity update; collision = per-substep collider setup + collide()). Arg batch8: the
-// collider's pass 0 eight particles at a time (1, the default) or one at a time (0).
+// and velocity update; collision = per-substep collider setup + collide()). Arg lanes: 16 = the
+// default where the CPU has AVX-512F (collision pass 0 sixteen particles at once, projection 16
+// constraints at once, the update four particles at once); 8 = the AVX kernels (as a CPU without
+// AVX-512F runs); 1 = the AVX kernels with the collider one particle at a time. Same results.
 void BM_GarmentFrame(benchmark::State& state) {
   static std::map<int, std::unique_ptr<GarmentScene>> cache;
   const int target = static_cast<int>(state.range(0));
@@ -117,8 +119,10 @@ void BM_GarmentFrame(benchmark::State& state) {
   EllipsoidCollider collider;
   std::string error;
   XpbdParams params;
-  params.collision.batch8 = state.range(1) != 0;  // pass 0 for 8 particles at once (same results)
+  params.collision.batch8 = state.range(1) >= 8;
+  params.collision.batch16 = state.range(1) == 16;
   s.setParams(params, error);
+  s.setWideProjection(state.range(1) == 16);
   const size_t frames = scene->pins.size();
   constexpr int kSubsteps = XpbdSolver::kDefaultSubsteps;
   size_t frame = 0;
@@ -159,8 +163,8 @@ void BM_GarmentFrame(benchmark::State& state) {
   state.counters["escapes"] = escapes / static_cast<double>(state.iterations());
 }
 BENCHMARK(BM_GarmentFrame)
-    ->ArgNames({"particles", "batch8"})
-    ->ArgsProduct({{2000, 8000, 32000}, {0, 1}})
+    ->ArgNames({"particles", "lanes"})
+    ->ArgsProduct({{2000, 8000, 32000}, {1, 8, 16}})
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace

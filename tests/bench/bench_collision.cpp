@@ -241,7 +241,8 @@ void BM_CollisionSetEllipsoids(benchmark::State& state) {
 BENCHMARK(BM_CollisionSetEllipsoids);
 
 // Args: particles, broad phase (0/1), scatter (0 = box, 1 = shell), response (0 radial, 1 exact),
-// batch8 (pass 0 for 8 particles at once: 1, the default; 0 one at a time).
+// lanes: pass 0 for 16 particles at once (16, the default where the CPU has AVX-512F; 8 there
+// without it), 8 at once (8: CollisionParams::batch16 off) or one at a time (1: batch8 off).
 // Each iteration collides a different set of particles (20 000 in all, cycled): the same 2 000
 // every iteration would let the branch predictor learn them and flatter the small case. Within
 // a set the particles are in Morton order, like the vertices of a cloth mesh.
@@ -255,7 +256,8 @@ void BM_CollisionSubstep(benchmark::State& state) {
   CollisionParams p;
   p.broad_phase = state.range(1) == 1;
   p.response = static_cast<ContactResponse>(state.range(3));
-  p.batch8 = state.range(4) != 0;
+  p.batch8 = state.range(4) >= 8;
+  p.batch16 = state.range(4) == 16;
   std::vector<Vec4> x(static_cast<size_t>(n));
   CollisionStats st;
   uint64_t contacts = 0, tests = 0, escapes = 0;
@@ -283,8 +285,8 @@ void BM_CollisionSubstep(benchmark::State& state) {
                                                      benchmark::Counter::OneK::kIs1000);
 }
 BENCHMARK(BM_CollisionSubstep)
-    ->ArgNames({"particles", "grid", "shell", "exact", "batch8"})
-    ->ArgsProduct({{2000, 20000}, {0, 1}, {0, 1}, {0, 1}, {0, 1}})
+    ->ArgNames({"particles", "grid", "shell", "exact", "lanes"})
+    ->ArgsProduct({{2000, 20000}, {0, 1}, {0, 1}, {0, 1}, {1, 8, 16}})
     ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
