@@ -258,7 +258,7 @@ TEST_P(GarmentOpeningsOfTemplates, EveryOpeningRoundItsBodyPartUntilCarriedOff) 
   for (size_t i = 0; i < at.size(); ++i) at[i] = g->positions()[i].head<3>();
   o.bind(g->mesh().indices, at, ctx.restBody());
   std::vector<uint8_t> on;
-  o.markOn(g->positions(), g->particleCount(), GarmentOpenings::bodyPolylines(ctx.restBody()), on);
+  o.markOn(g->positions(), g->particleCount(), ctx.restBody(), on);
   ASSERT_EQ(on.size(), g->particleCount());
   size_t rim_particles = 0;
   for (const std::vector<uint32_t>& loop : boundaryLoops(g->mesh().indices, g->particleCount()))
@@ -276,7 +276,7 @@ TEST_P(GarmentOpeningsOfTemplates, EveryOpeningRoundItsBodyPartUntilCarriedOff) 
   EXPECT_EQ(carried.openings.tracked, GetParam().openings);
   EXPECT_EQ(carried.openings.off, GetParam().openings);
   // ... and the gate marks nothing.
-  o.markOn(g->positions(), g->particleCount(), GarmentOpenings::bodyPolylines(ctx.restBody()), on);
+  o.markOn(g->positions(), g->particleCount(), ctx.restBody(), on);
   EXPECT_EQ(std::count(on.begin(), on.end(), uint8_t{1}), 0);
 }
 

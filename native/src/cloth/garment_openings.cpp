@@ -172,10 +172,11 @@ OpeningCount GarmentOpenings::count(const Eigen::Vector4f* x, size_t n, const Bo
   return c;
 }
 
-void GarmentOpenings::markOn(const Eigen::Vector4f* x, size_t n, const std::vector<std::vector<Vec3>>& parts,
-                             std::vector<uint8_t>& on) const {
+void GarmentOpenings::markOn(const Eigen::Vector4f* x, size_t n, const BodyModel& body, std::vector<uint8_t>& on) const {
   on.assign(n, 0);
-  forEachOn(x, n, parts, [&](const Opening& o, bool is_on) {
+  if (openings_.empty()) return;
+  bodyPolylines(body, parts_scratch_);
+  forEachOn(x, n, parts_scratch_, [&](const Opening& o, bool is_on) {
     if (is_on)
       for (uint32_t i : o.loop) on[i] = 1;
   }, /*limbs_only=*/true);

@@ -62,10 +62,7 @@ class GarmentOpenings {
   // spine's openings, loops not tracked, interior particles). The rim gate (GarmentSim): a rim keeps
   // a limb in, not out; only a limb is thin enough to slip between two rim particles, and the
   // spine's hem and collar are the largest loops to test (docs/collision.md, "Rim edges").
-  // `parts`: the body-part polylines (bodyPolylines) to test against (the rim gate's: the body at
-  // the step's end, GarmentSim::runStepFrame).
-  void markOn(const Eigen::Vector4f* x, size_t n, const std::vector<std::vector<Vec3>>& parts,
-              std::vector<uint8_t>& on) const;
+  void markOn(const Eigen::Vector4f* x, size_t n, const BodyModel& body, std::vector<uint8_t>& on) const;
 
   // The body-part polylines (spine, arms, legs) of `body`: see the file comment.
   static std::vector<std::vector<Vec3>> bodyPolylines(const BodyModel& body);
@@ -79,7 +76,7 @@ class GarmentOpenings {
     int sign;                    // of the linking at rest
   };
   std::vector<Opening> openings_;  // the tracked ones only
-  mutable std::vector<std::vector<Vec3>> parts_scratch_;  // count's, kept between calls
+  mutable std::vector<std::vector<Vec3>> parts_scratch_;  // count's and markOn's, kept between calls
   mutable std::vector<Vec3> loop_scratch_;
   // f(opening, on) for every tracked opening (limbs_only: those round an arm or a leg), on = round
   // its body part (parts[opening.part]) now (count's test).

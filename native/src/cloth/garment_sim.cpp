@@ -678,8 +678,7 @@ void GarmentSim::runStepFrame(const std::vector<Ellipsoid>& start, const std::ve
   // "Rim edges": the gate's cost). Against the body at the step's end: against its start (the
   // last step's end, carried) the ASan build's 10 Hz frame-rate scenario tore (docs/garments.md,
   // "The rim gate at the step's start").
-  GarmentOpenings::bodyPolylines(*pending_body_, gate_parts_);
-  openings_.markOn(solver_->x(), particleCount(), gate_parts_, rim_gate_);
+  openings_.markOn(solver_->x(), particleCount(), *pending_body_, rim_gate_);
   solver_->setRimGate(rim_gate_);
   staging_ = allow_staging_;
   runFrame(start, end, pins, dt);

@@ -404,9 +404,6 @@ class GarmentSim {
   EllipsoidCollider collider_;
   std::vector<uint8_t> masks_, groups_;  // groups_: base_groups_ as met now (applyLegGroups)
   std::vector<uint8_t> rim_gate_;        // runStepFrame: the particles of openings on their part
-  // The body-part polylines (GarmentOpenings::bodyPolylines) the rim gate tests the openings
-  // against (runStepFrame's scratch, kept between steps).
-  std::vector<std::vector<Vec3>> gate_parts_;
   std::vector<uint8_t> base_groups_;      // each ellipsoid's collision groups, as given to create()
   // Torso cloth meets a leg's ellipsoid while the host trusts that leg (setLegsTrusted) and the
   // ellipsoid is clear: it held no torso cloth when the garment was last placed on the body (first

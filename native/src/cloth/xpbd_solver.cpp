@@ -1,6 +1,7 @@
 #include "cloth/xpbd_solver.h"
 
 #include "common/cpu.h"
+#include "common/simd_transpose.h"
 
 #include <algorithm>
 #include <chrono>
@@ -222,20 +223,13 @@ __attribute__((target("avx"), always_inline)) inline void gather8(Vec4* x, const
                                                                   __m256& py, __m256& pz, __m256& pw) {
   __m256 r[4];
   for (int i = 0; i < 4; ++i) r[i] = kQuads ? _mm256_loadu_ps(at(x, off[i])) : pair8(x, off, i);
-  const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
-  const __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
-  px = _mm256_shuffle_ps(t0, t2, 0x44);
-  py = _mm256_shuffle_ps(t0, t2, 0xEE);
-  pz = _mm256_shuffle_ps(t1, t3, 0x44);
-  pw = _mm256_shuffle_ps(t1, t3, 0xEE);
+  simd::transpose4(r[0], r[1], r[2], r[3], px, py, pz, pw);
 }
 template <bool kQuads>
 __attribute__((target("avx"), always_inline)) inline void scatter8(Vec4* x, const uint32_t* off, __m256 px,
                                                                    __m256 py, __m256 pz, __m256 pw) {
-  const __m256 t0 = _mm256_unpacklo_ps(px, py), t1 = _mm256_unpackhi_ps(px, py);
-  const __m256 t2 = _mm256_unpacklo_ps(pz, pw), t3 = _mm256_unpackhi_ps(pz, pw);
-  const __m256 r[4] = {_mm256_shuffle_ps(t0, t2, 0x44), _mm256_shuffle_ps(t0, t2, 0xEE),
-                       _mm256_shuffle_ps(t1, t3, 0x44), _mm256_shuffle_ps(t1, t3, 0xEE)};
+  __m256 r[4];
+  simd::transpose4(px, py, pz, pw, r[0], r[1], r[2], r[3]);
   for (int i = 0; i < 4; ++i) {
     if (kQuads) {
       _mm256_storeu_ps(at(x, off[i]), r[i]);
@@ -347,20 +341,13 @@ DRAPE_AVX512_FN __attribute__((always_inline)) inline void gather16(Vec4* x, con
                                                                     __m512& py, __m512& pz, __m512& pw) {
   __m512 r[4];
   for (int i = 0; i < 4; ++i) r[i] = kQuads ? _mm512_loadu_ps(at(x, off[i])) : quad16(x, off, i);
-  const __m512 t0 = _mm512_unpacklo_ps(r[0], r[1]), t1 = _mm512_unpackhi_ps(r[0], r[1]);
-  const __m512 t2 = _mm512_unpacklo_ps(r[2], r[3]), t3 = _mm512_unpackhi_ps(r[2], r[3]);
-  px = _mm512_shuffle_ps(t0, t2, 0x44);
-  py = _mm512_shuffle_ps(t0, t2, 0xEE);
-  pz = _mm512_shuffle_ps(t1, t3, 0x44);
-  pw = _mm512_shuffle_ps(t1, t3, 0xEE);
+  simd::transpose4(r[0], r[1], r[2], r[3], px, py, pz, pw);
 }
 template <bool kQuads>
 DRAPE_AVX512_FN __attribute__((always_inline)) inline void scatter16(Vec4* x, const uint32_t* off, __m512 px,
                                                                      __m512 py, __m512 pz, __m512 pw) {
-  const __m512 t0 = _mm512_unpacklo_ps(px, py), t1 = _mm512_unpackhi_ps(px, py);
-  const __m512 t2 = _mm512_unpacklo_ps(pz, pw), t3 = _mm512_unpackhi_ps(pz, pw);
-  const __m512 r[4] = {_mm512_shuffle_ps(t0, t2, 0x44), _mm512_shuffle_ps(t0, t2, 0xEE),
-                       _mm512_shuffle_ps(t1, t3, 0x44), _mm512_shuffle_ps(t1, t3, 0xEE)};
+  __m512 r[4];
+  simd::transpose4(px, py, pz, pw, r[0], r[1], r[2], r[3]);
   for (int i = 0; i < 4; ++i) {
     if (kQuads) {
       _mm512_storeu_ps(at(x, off[i]), r[i]);

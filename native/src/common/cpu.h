@@ -1,6 +1,7 @@
 // What the CPU the library runs on can do, checked once at run time: the 8-wide AVX kernels (XPBD
-// projection, collision pass 0) and the 16-wide AVX-512 one (XPBD projection) are chosen per call,
-// so one build runs on every x86-64. Also the inlining hints those hot loops share.
+// projection, collision pass 0, the fused update) and the AVX-512 ones (the same three, 16 or 4
+// wide) are chosen per call, so one build runs on every x86-64. Also the inlining hints those hot
+// loops share.
 #pragma once
 
 #if defined(__GNUC__)
@@ -18,7 +19,7 @@ inline bool cpuHasAvx() {
   static const bool avx = __builtin_cpu_supports("avx");
   return avx;
 }
-// AVX-512 Foundation (Zen 4 and later, Intel since Skylake-SP): the 16-lane XPBD kernel.
+// AVX-512 Foundation (Zen 4 and later, Intel since Skylake-SP): the 16-lane kernels.
 inline bool cpuHasAvx512() {
   static const bool avx512 = __builtin_cpu_supports("avx512f");
   return avx512;

@@ -14,6 +14,8 @@
 
 #include <Eigen/Core>
 
+#include "common/simd_transpose.h"
+
 #include <cstdint>
 #include <cstring>
 
@@ -124,12 +126,7 @@ DRAPE_LANE_FN void loadPositions(const Eigen::Vector4f* v, V& x, V& y, V& z, V& 
   __m256 r[4];
   for (int i = 0; i < 4; ++i)
     r[i] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(v[i].data())), _mm_loadu_ps(v[i + 4].data()), 1);
-  const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
-  const __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
-  x = _mm256_shuffle_ps(t0, t2, 0x44);
-  y = _mm256_shuffle_ps(t0, t2, 0xEE);
-  z = _mm256_shuffle_ps(t1, t3, 0x44);
-  w = _mm256_shuffle_ps(t1, t3, 0xEE);
+  simd::transpose4(r[0], r[1], r[2], r[3], x, y, z, w);
 }
 // The lanes' collision masks (masks[0..8)) for the lanes in `on` into out (0 elsewhere); returns
 // the union of those masks in `joint` and whether they differ. The eight bytes as one word.
@@ -235,12 +232,7 @@ DRAPE_LANE_FN void loadPositions(const Eigen::Vector4f* v, V& x, V& y, V& z, V& 
     r[i] = _mm512_insertf32x4(r[i], _mm_loadu_ps(v[i + 8].data()), 2);
     r[i] = _mm512_insertf32x4(r[i], _mm_loadu_ps(v[i + 12].data()), 3);
   }
-  const __m512 t0 = _mm512_unpacklo_ps(r[0], r[1]), t1 = _mm512_unpackhi_ps(r[0], r[1]);
-  const __m512 t2 = _mm512_unpacklo_ps(r[2], r[3]), t3 = _mm512_unpackhi_ps(r[2], r[3]);
-  x = _mm512_shuffle_ps(t0, t2, 0x44);
-  y = _mm512_shuffle_ps(t0, t2, 0xEE);
-  z = _mm512_shuffle_ps(t1, t3, 0x44);
-  w = _mm512_shuffle_ps(t1, t3, 0xEE);
+  simd::transpose4(r[0], r[1], r[2], r[3], x, y, z, w);
 }
 // lanes8::laneMasks for sixteen lanes: the bytes of the lanes not in `on` cleared through a
 // 0xFF-per-lane byte mask (AVX-512F's dword-to-byte narrowing), then the union folded in one word.
