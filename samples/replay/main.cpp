@@ -179,6 +179,7 @@ int run(int argc, char** argv) {
     else if (opt.solver == DRAPE_SOLVER_MASS_SPRING) cloth.substep_hz = kMassSpringSubstepHz;
     if (opt.iterations != 0) cloth.iterations = opt.iterations;
     if (opt.strain_limit >= 0.0) cloth.strain_limit = static_cast<float>(opt.strain_limit);
+    if (opt.collision_stride >= 0) cloth.collision_stride = static_cast<uint32_t>(opt.collision_stride);
     // A frame a little longer than 1/30 s must not hit the per-step cap (which would lengthen
     // every substep instead of adding some).
     const uint32_t per_frame = static_cast<uint32_t>(std::ceil(cloth.substep_hz / 30.0f));
@@ -311,6 +312,7 @@ int run(int argc, char** argv) {
     st.substep_hz = actual.substep_hz;
     st.iterations = actual.iterations;
     st.strain_limit = actual.strain_limit;
+    st.collision_stride = actual.collision_stride;
     st.particles = garment_vertices;
     st.garment_triangles = garment_index_count / 3;
     st.attached = gs.attached;

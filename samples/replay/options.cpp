@@ -294,6 +294,15 @@ bool parseOptions(int argc, const char* const* argv, Options& o, std::string& er
         return false;
       }
       o.strain_limit = v;
+    } else if (name == "--collision-stride") {
+      if (!takeValue()) return false;
+      uint32_t v = 0;
+      if (!parseUint(value, 0, 8, v)) {
+        error = "--collision-stride '" + value +
+                "' is not a whole number in [0, 8] (collision every N substeps; 0 = by the garment's resolution)";
+        return false;
+      }
+      o.collision_stride = static_cast<int32_t>(v);
     } else if (name == "--measure-every" || name == "--garment-every") {
       if (!takeValue()) return false;
       if (!parseUint(value, 0, 0xffffffffUL, o.measure_every)) {
@@ -357,15 +366,20 @@ bool parseOptions(int argc, const char* const* argv, Options& o, std::string& er
   }
   // Garment options that the chosen garment would silently ignore are mistakes.
   if (o.garment_none && (o.particles != 0 || o.solver_given || o.substeps != 0 || o.iterations != 0 ||
-                         o.strain_limit >= 0.0 || o.measure_given)) {
+                         o.strain_limit >= 0.0 || o.collision_stride >= 0 || o.measure_given)) {
     error = std::string(o.particles != 0 ? "--particles" : o.solver_given ? "--solver"
                         : o.substeps != 0 ? "--substeps" : o.iterations != 0 ? "--iterations"
-                        : o.strain_limit >= 0.0 ? "--strain-limit" : "--measure-every") +
+                        : o.strain_limit >= 0.0 ? "--strain-limit"
+                        : o.collision_stride >= 0 ? "--collision-stride" : "--measure-every") +
             " has no effect with --garment none; drop it or choose a garment";
     return false;
   }
   if (o.strain_limit >= 0.0 && o.solver == DRAPE_SOLVER_MASS_SPRING) {
     error = "--strain-limit has no effect with --solver massspring (an XPBD setting); drop it";
+    return false;
+  }
+  if (o.collision_stride >= 0 && o.solver == DRAPE_SOLVER_MASS_SPRING) {
+    error = "--collision-stride has no effect with --solver massspring (it collides every substep); drop it";
     return false;
   }
   if (o.iterations != 0 && o.solver == DRAPE_SOLVER_MASS_SPRING) {
@@ -453,6 +467,9 @@ std::string helpText() {
       "  --strain-limit F      XPBD: at the end of each step, structural edges longer than\n"
       "                        rest * (1 + F) are pulled back to that length, F in [0, 10]\n"
       "                        (default 0.1; 0 = off)\n"
+      "  --collision-stride N  XPBD: collide with the ellipsoids every N substeps, N in [0, 8]\n"
+      "                        (default 0: every substep for a garment of at most 1 250\n"
+      "                        particles, every second one above)\n"
       "  --measure-every N     measure the garment's accuracy (stretch, ellipsoid and body\n"
       "                        penetration; ~1 ms per 1 000 particles) every N frames (default 1;\n"
       "                        0 = never). Alias: --garment-every\n"

@@ -189,9 +189,11 @@ std::string statsJson(const ReplayStats& s) {
     if (s.solver == DRAPE_SOLVER_MASS_SPRING) {
       w.key("iterations").null();
       w.key("strain_limit").null();
+      w.key("collision_stride").null();
     } else {
       w.key("iterations").value(s.iterations);
       w.key("strain_limit").value(s.strain_limit);
+      w.key("collision_stride").value(s.collision_stride);
     }
   } else {
     w.key("kind").value("none");
@@ -200,6 +202,7 @@ std::string statsJson(const ReplayStats& s) {
     w.key("substep_hz").null();
     w.key("iterations").null();
     w.key("strain_limit").null();
+    w.key("collision_stride").null();
   }
   w.key("triangles").value(s.garment_triangles);
   w.key("edges").value(static_cast<int64_t>(s.stretch.edgeCount()));

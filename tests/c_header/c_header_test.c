@@ -103,6 +103,8 @@ int main(void) {
   CHECK(desc.struct_size == sizeof(drape_context_desc));
   CHECK(desc.arms_clear_torso == 1);
   CHECK(offsetof(drape_context_desc, arms_clear_torso) == DRAPE_CONTEXT_DESC_SIZE_V1);
+  CHECK(offsetof(drape_cloth_params, collision_stride) == DRAPE_CLOTH_PARAMS_SIZE_V1);
+  CHECK(sizeof(drape_cloth_params) == DRAPE_CLOTH_PARAMS_SIZE_V1 + 4);
   CHECK_OK(drape_context_create(&desc, &ctx));
   if (ctx == NULL) {
     fprintf(stderr, "no context: giving up\n");

@@ -71,6 +71,7 @@ TEST(CApiGarments, InitFunctionsFillDefaults) {
   EXPECT_FLOAT_EQ(c.gravity.y, -9.81f);
   EXPECT_EQ(c.contact_response, DRAPE_CONTACT_EXACT);
   EXPECT_EQ(c.continuous_collision, 1u);
+  EXPECT_EQ(c.collision_stride, 0u);  // by the garment's resolution
   drape_mesh_fit f;
   ASSERT_OK(drape_mesh_fit_init(&f));
   EXPECT_FLOAT_EQ(f.source_height_m, 1.60f);
@@ -191,6 +192,75 @@ TEST(CApiGarments, AccuracyCountsOpeningsAndTheFirstStructVersionIsStillFilled) 
                                  [&](drape_garment_accuracy* out) { return drape_garment_measure(g, out); });
 }
 
+// drape_cloth_params grew collision_stride (128 -> 132 bytes): a caller of the first layout reads
+// its 128 bytes and nothing past them, and its params, set or given at creation, are read to
+// their struct_size only, collision_stride taking its default (0: by the resolution) whatever
+// lies beyond.
+TEST(CApiGarments, ClothParamsOfTheFirstStructVersionAreStillRead) {
+  ContextPtr ctx = makeContext();
+  drape_garment* g = addTShirt(ctx.get(), 400);
+  ASSERT_NE(g, nullptr);
+  drape_cloth_params full;
+  full.struct_size = sizeof(full);
+  ASSERT_OK(drape_garment_get_params(g, &full));
+  EXPECT_EQ(full.struct_size, 132u);
+  expectFirstStructVersionFilled(full, DRAPE_CLOTH_PARAMS_SIZE_V1, "drape_cloth_params.struct_size",
+                                 [&](drape_cloth_params* out) { return drape_garment_get_params(g, out); });
+  // Set: an explicit stride, then the first layout with garbage where collision_stride would be.
+  drape_cloth_params p = full;
+  p.collision_stride = 1;
+  ASSERT_OK(drape_garment_set_params(g, &p));
+  drape_cloth_params now;
+  now.struct_size = sizeof(now);
+  ASSERT_OK(drape_garment_get_params(g, &now));
+  EXPECT_EQ(now.collision_stride, 1u);
+  p = full;
+  p.struct_size = DRAPE_CLOTH_PARAMS_SIZE_V1;
+  p.damping = 2.5f;
+  p.collision_stride = 0xFFFFFFFFu;  // past the caller's struct: not read
+  ASSERT_OK(drape_garment_set_params(g, &p)) << lastError();
+  ASSERT_OK(drape_garment_get_params(g, &now));
+  EXPECT_EQ(now.collision_stride, 0u);
+  EXPECT_FLOAT_EQ(now.damping, 2.5f);
+  // At creation too.
+  drape_garment_template t;
+  ASSERT_OK(drape_garment_template_init(&t));
+  t.particles = 400;
+  drape_garment* g2 = nullptr;
+  ASSERT_OK(drape_context_add_garment_template(ctx.get(), nullptr, &t, &p, &g2)) << lastError();
+  ASSERT_OK(drape_garment_get_params(g2, &now));
+  EXPECT_EQ(now.collision_stride, 0u);
+  EXPECT_FLOAT_EQ(now.damping, 2.5f);
+}
+
+// collision_stride 0 runs every substep for a garment of at most 1 250 particles and every second
+// one above (docs/garments.md, "Coarse garments collide every substep"): bit for bit the garment
+// that asks for that stride.
+TEST(CApiGarments, CollisionStrideByResolution) {
+  const uint32_t coarse = 400, fine = drape::test::kSanitizedBuild ? 1400 : 2000;
+  for (const uint32_t particles : {coarse, fine}) {
+    std::vector<float> x[3];
+    for (uint32_t stride : {0u, 1u, 2u}) {
+      ContextPtr ctx = makeContext();
+      drape_garment_template t;
+      ASSERT_OK(drape_garment_template_init(&t));
+      t.particles = particles;
+      drape_cloth_params c;
+      ASSERT_OK(drape_cloth_params_init(&c));
+      c.collision_stride = stride;
+      drape_garment* g = nullptr;
+      ASSERT_OK(drape_context_add_garment_template(ctx.get(), nullptr, &t, &c, &g)) << lastError();
+      for (int i = 0; i < 12; ++i) ASSERT_OK(pushAndStep(ctx.get(), 40 + i));
+      x[stride] = snapshot(g);
+    }
+    const size_t n = x[0].size() / 4;
+    ASSERT_TRUE(particles == coarse ? n <= 1250 : n > 1250) << n;
+    const int same = particles == coarse ? 1 : 2, other = 3 - same;
+    EXPECT_EQ(x[0], x[same]) << particles << " particles";
+    EXPECT_NE(x[0], x[other]) << particles << " particles: the two strides should differ here";
+  }
+}
+
 TEST(CApiGarments, SameInputGivesBitIdenticalGarments) {
   ContextPtr a = makeContext(), b = makeContext();
   // Under the sanitizers 400 particles instead of 1 000: the same code runs for every particle of
@@ -232,7 +302,12 @@ TEST(CApiGarments, BadParametersAreRejectedAndChangeNothing) {
       {"NaN strain_limit", [](drape_cloth_params& p) { p.strain_limit = kNaN; }, DRAPE_ERROR_NONFINITE},
       {"negative strain_limit", [](drape_cloth_params& p) { p.strain_limit = -0.01f; }, DRAPE_ERROR_OUT_OF_RANGE},
       {"strain_limit above 10", [](drape_cloth_params& p) { p.strain_limit = 11.0f; }, DRAPE_ERROR_OUT_OF_RANGE},
+      {"collision_stride 9", [](drape_cloth_params& p) { p.collision_stride = 9; }, DRAPE_ERROR_OUT_OF_RANGE},
+      {"collision_stride 2^32 - 1", [](drape_cloth_params& p) { p.collision_stride = 0xFFFFFFFFu; },
+       DRAPE_ERROR_OUT_OF_RANGE},
       {"struct_size", [](drape_cloth_params& p) { p.struct_size = 8; }, DRAPE_ERROR_INVALID_ARGUMENT},
+      {"struct_size of the first version minus 4",
+       [](drape_cloth_params& p) { p.struct_size = DRAPE_CLOTH_PARAMS_SIZE_V1 - 4; }, DRAPE_ERROR_INVALID_ARGUMENT},
   };
   for (const Case& c : cases) {
     drape_cloth_params p = before;

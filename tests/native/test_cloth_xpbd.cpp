@@ -477,6 +477,24 @@ TEST(ClothXpbd, AtRestNothingMovesAndPaddingStaysHidden) {
   EXPECT_EQ(s.particleCount(), 3u);
 }
 
+TEST(ClothXpbd, CollisionStrideByResolution) {
+  // 0: every substep up to kCollideEverySubstepMaxParticles particles, every second one above; a
+  // stride that is set is kept whatever the resolution.
+  EXPECT_EQ(kCollideEverySubstepMaxParticles, 1250u);
+  EXPECT_EQ(collisionStrideFor(0, 1), 1);
+  EXPECT_EQ(collisionStrideFor(0, 1250), 1);
+  EXPECT_EQ(collisionStrideFor(0, 1251), 2);
+  EXPECT_EQ(collisionStrideFor(0, 32000), 2);
+  EXPECT_EQ(collisionStrideFor(1, 32000), 1);
+  EXPECT_EQ(collisionStrideFor(3, 100), 3);
+  XpbdSolver s(square(8, true));
+  XpbdParams p;
+  p.collision_stride = 0;
+  std::string error;
+  EXPECT_TRUE(s.setParams(p, error)) << error;
+  EXPECT_EQ(s.params().collision_stride, 0);  // kept as asked: resolved per step
+}
+
 TEST(ClothXpbd, RejectsBadArgumentsAndChangesNothing) {
   XpbdSolver s(square(8, true));
   const std::vector<Eigen::Vector4f> before(s.positions(), s.positions() + s.particleCount());
@@ -498,6 +516,13 @@ TEST(ClothXpbd, RejectsBadArgumentsAndChangesNothing) {
   bad = XpbdParams{};
   bad.tether_scale = 0.5f;
   EXPECT_FALSE(s.setParams(bad, error));
+  for (int stride : {-1, 9}) {
+    bad = XpbdParams{};
+    bad.collision_stride = stride;
+    error.clear();
+    EXPECT_FALSE(s.setParams(bad, error)) << stride;
+    EXPECT_NE(error.find("collision_stride"), std::string::npos) << error;
+  }
   EXPECT_EQ(s.params().bend_compliance, XpbdParams{}.bend_compliance);
   const Vec3 one[1] = {Vec3::Zero()};
   EXPECT_FALSE(s.setPinTargets(one, 1, error));

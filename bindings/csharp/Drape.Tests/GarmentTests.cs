@@ -107,7 +107,7 @@ namespace Drape.Tests
             Assert.Equal(GarmentKind.Skirt, GarmentTemplate.CreateDefault(GarmentKind.Skirt).Kind);
 
             ClothParams c = ClothParams.CreateDefault();
-            Assert.Equal(128u, c.StructSize);
+            Assert.Equal(132u, c.StructSize);
             Assert.Equal(300f, c.SubstepHz);
             Assert.Equal(1u, c.Iterations);
             Assert.Equal(200u, c.MaxSubsteps);
@@ -116,6 +116,7 @@ namespace Drape.Tests
             Assert.True(c.IsContinuousCollision);
             Assert.Equal(0.004f, c.CollisionMarginM, 1e-6f);
             Assert.Equal(0.1f, c.StrainLimit, 1e-6f);
+            Assert.Equal(0u, c.CollisionStride);
 
             MeshFit f = MeshFit.CreateDefault();
             Assert.Equal(48u, f.StructSize);

@@ -578,7 +578,7 @@ namespace Drape
         }
     }
 
-    /// <summary>drape_cloth_params (128 bytes): the cloth parameters of a garment; they may change
+    /// <summary>drape_cloth_params (132 bytes): the cloth parameters of a garment; they may change
     /// at any time (<see cref="Garment.Params"/>). Start from <see cref="CreateDefault"/>. Ranges are
     /// checked by the library as a whole: NaN/Inf gives <see cref="ResultCode.NonFinite"/>, a value
     /// outside its range <see cref="ResultCode.OutOfRange"/>.</summary>
@@ -647,6 +647,13 @@ namespace Drape
         /// rest * (1 + StrainLimit) are pulled back to that length (two passes, before the last
         /// collision), [0, 10], 0 = off; default 0.1. The mass-spring solver ignores it.</summary>
         public float StrainLimit;
+        /// <summary>collision_stride: XPBD, collide with the ellipsoids every Nth substep (the swept
+        /// test spans the N substeps), [0, 8]; default 0: by the garment's resolution, every substep
+        /// for at most 1 250 particles (coarse sleeves and trouser legs otherwise come off the limbs)
+        /// and every second one above. 1 costs about twice the collision time of 2. The mass-spring
+        /// solver collides every substep and ignores it. Added after the rest (the struct grew from
+        /// 128 to 132 bytes); the library still accepts the 128-byte layout.</summary>
+        public uint CollisionStride;
 
         /// <summary><see cref="ContinuousCollision"/> as a bool.</summary>
         public bool IsContinuousCollision

@@ -532,7 +532,19 @@ typedef struct drape_cloth_params {
                                   Takes the place of a `reserved` field that had to be 0, so
                                   older callers keep their behaviour (off). The mass-spring
                                   solver ignores it */
+  /* The last field came after the rest: params whose struct_size is DRAPE_CLOTH_PARAMS_SIZE_V1
+   * (128, the layout without it) are accepted and get its default. */
+  uint32_t collision_stride;   /* XPBD: collide with the ellipsoids every Nth substep (the swept
+                                  test spans the N substeps), [0, 8]; 0 (default): by the garment's
+                                  resolution, every substep for at most 1 250 particles (coarse
+                                  sleeves and trouser legs otherwise come off the limbs) and every
+                                  second one above (docs/garments.md, "Coarse garments collide every
+                                  substep"). 1 costs about twice the collision time of 2. The
+                                  mass-spring solver collides every substep and ignores it */
 } drape_cloth_params;
+
+/* sizeof(drape_cloth_params) before collision_stride. */
+#define DRAPE_CLOTH_PARAMS_SIZE_V1 128u
 
 DRAPE_API drape_result DRAPE_CALL drape_cloth_params_init(drape_cloth_params* params);
 

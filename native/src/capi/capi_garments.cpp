@@ -86,6 +86,7 @@ drape_result toSimParams(const char* fn, const drape_cloth_params& c, drape::Gar
   k.range(w, "spring_damping", c.spring_damping, 0.0f, 1e6f);
   k.range(w, "iterations", static_cast<float>(c.iterations), 1.0f, 64.0f);
   k.range(w, "strain_limit", c.strain_limit, 0.0f, 10.0f);
+  k.range(w, "collision_stride", static_cast<float>(c.collision_stride), 0.0f, 8.0f);
   if (drape_result r = k.done(fn)) return r;
   drape::GarmentSimParams p;
   p.substep_hz = c.substep_hz;
@@ -116,6 +117,7 @@ drape_result toSimParams(const char* fn, const drape_cloth_params& c, drape::Gar
   p.mass_spring.spring_damping = c.spring_damping;
   p.xpbd.iterations = static_cast<int>(c.iterations);
   p.xpbd.strain_limit = c.strain_limit;
+  p.xpbd.collision_stride = static_cast<int>(c.collision_stride);
   const std::string e = drape::validate(p);
   if (!e.empty()) return fail(DRAPE_ERROR_OUT_OF_RANGE, std::string(fn) + ": cloth params: " + e);
   out = p;
@@ -153,6 +155,20 @@ void fromSimParams(const drape::GarmentSimParams& p, drape_cloth_params& c) {
   c.spring_damping = p.mass_spring.spring_damping;
   c.iterations = static_cast<uint32_t>(p.xpbd.iterations);
   c.strain_limit = p.xpbd.strain_limit;
+  c.collision_stride = static_cast<uint32_t>(p.xpbd.collision_stride);
+}
+
+// A caller's drape_cloth_params, of the first layout (struct_size DRAPE_CLOTH_PARAMS_SIZE_V1,
+// without collision_stride) or the current one: the fields its struct_size covers whole, the
+// later one's default. Nothing past the caller's struct_size is read.
+drape_result readClothParams(const drape_cloth_params& in, drape_cloth_params& out) {
+  if (drape_result r = checkStructSize(in.struct_size, DRAPE_CLOTH_PARAMS_SIZE_V1, "drape_cloth_params")) return r;
+  drape_cloth_params_init(&out);
+  std::memcpy(&out, &in, DRAPE_CLOTH_PARAMS_SIZE_V1);
+  if (in.struct_size >= offsetof(drape_cloth_params, collision_stride) + sizeof(out.collision_stride))
+    out.collision_stride = in.collision_stride;
+  out.struct_size = sizeof(drape_cloth_params);
+  return DRAPE_OK;
 }
 
 // Resolves the optional desc and cloth structs (NULL: defaults) and validates them.
@@ -174,8 +190,7 @@ drape_result readCommon(const char* fn, const drape_garment_desc* desc, const dr
   drape_cloth_params c;
   drape_cloth_params_init(&c);
   if (cloth) {
-    if (drape_result r = checkStructSize(cloth->struct_size, sizeof(drape_cloth_params), "drape_cloth_params")) return r;
-    c = *cloth;
+    if (drape_result r = readClothParams(*cloth, c)) return r;
   }
   return toSimParams(fn, c, sim);
 }
@@ -449,9 +464,10 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_set_params(drape_garment* handle
   return guarded(fn, [&]() -> drape_result {
     DRAPE_CHECK_GARMENT("drape_garment_set_params", handle);
     if (!params) return fail(DRAPE_ERROR_NULL_ARGUMENT, std::string(fn) + ": params is NULL");
-    if (drape_result r = checkStructSize(params->struct_size, sizeof(drape_cloth_params), "drape_cloth_params")) return r;
+    drape_cloth_params c;
+    if (drape_result r = readClothParams(*params, c)) return r;
     drape::GarmentSimParams sim;
-    if (drape_result r = toSimParams(fn, *params, sim)) return r;
+    if (drape_result r = toSimParams(fn, c, sim)) return r;
     std::string err;
     if (!garment->setParams(sim, err)) return fail(DRAPE_ERROR_OUT_OF_RANGE, std::string(fn) + ": " + err);
     // New parameters change how the cloth hangs: a sleeping garment steps again (adaptive.h).
@@ -464,11 +480,12 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_get_params(drape_garment* handle
   return guarded("drape_garment_get_params", [&]() -> drape_result {
     DRAPE_CHECK_GARMENT("drape_garment_get_params", handle);
     if (!out) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_garment_get_params: out_params is NULL");
-    if (drape_result r = checkStructSize(out->struct_size, sizeof(drape_cloth_params), "drape_cloth_params")) return r;
+    if (drape_result r = checkStructSize(out->struct_size, DRAPE_CLOTH_PARAMS_SIZE_V1, "drape_cloth_params")) return r;
     drape_cloth_params c;
-    c.struct_size = sizeof(c);
+    c.struct_size = out->struct_size;
     fromSimParams(garment->params(), c);
-    *out = c;
+    // A caller of the first layout gets its 128 bytes; nothing past its struct_size is written.
+    std::memcpy(out, &c, std::min<size_t>(out->struct_size, sizeof(c)));
     return DRAPE_OK;
   });
 }
@@ -623,4 +640,6 @@ static_assert(sizeof(drape_garment_stats) == 104, "drape_garment_stats layout");
 static_assert(offsetof(drape_garment_stats, device_upload_ms) == 72, "drape_garment_stats: the first version's 72 bytes moved");
 static_assert(sizeof(drape_garment_accuracy) == 40, "drape_garment_accuracy layout");
 static_assert(offsetof(drape_garment_accuracy, openings) == 32, "drape_garment_accuracy: the first version's 32 bytes moved");
-static_assert(sizeof(drape_cloth_params) == 128, "drape_cloth_params layout");
+static_assert(sizeof(drape_cloth_params) == 132, "drape_cloth_params layout");
+static_assert(offsetof(drape_cloth_params, collision_stride) == DRAPE_CLOTH_PARAMS_SIZE_V1,
+              "drape_cloth_params: the first version's 128 bytes moved");

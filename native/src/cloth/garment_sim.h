@@ -49,7 +49,9 @@ struct GarmentSimParams {
   // Collision runs every second substep (150 Hz at the default 300 Hz; the swept test covers the
   // two substeps): collision cost halves and stretch, penetration and particles inside stay
   // within the run-to-run noise on the shared takes; every third substep made the 120 Hz BVH
-  // takes (3 substeps a frame) unstable (docs/garments.md).
+  // takes (3 substeps a frame) unstable (docs/garments.md). A garment of at most 1 250 particles
+  // collides every substep (collision_stride 0, collisionStrideFor in cloth/xpbd_solver.h): its
+  // coarse sleeves came off the arms (docs/garments.md, "Coarse garments collide every substep").
   // The strain limit (10 %, two passes at the end of each step, XpbdParams::strain_limit): on the
   // shared takes x templates the pooled P99 stretch fell in 37 of 40 runs (geometric mean x 0.82,
   // Ges01 T-shirt 16.2 -> 12.4 %) with the body penetration within the run-to-run noise, for
@@ -58,7 +60,7 @@ struct GarmentSimParams {
   GarmentSimParams() {
     xpbd.collision.max_escape_m = 0.01f;
     xpbd.tether_scale = 1.1f;
-    xpbd.collision_stride = 2;
+    xpbd.collision_stride = 0;
     xpbd.strain_limit = 0.1f;
   }
 

@@ -690,8 +690,8 @@ bool XpbdSolver::setParams(const XpbdParams& p, std::string& error) {
     error = "max_speed must be finite (<= 0 disables the clamp)";
     return false;
   }
-  if (p.collision_stride < 1 || p.collision_stride > 8) {
-    error = "collision_stride must be in [1, 8]";
+  if (p.collision_stride < 0 || p.collision_stride > 8) {
+    error = "collision_stride must be in [0, 8] (0: by the garment's resolution)";
     return false;
   }
   if (p.iterations < 1 || p.iterations > 64) {
@@ -758,7 +758,7 @@ bool XpbdSolver::step(float dt, int substeps) {
   timings_ = XpbdTimings{};
   const float h = dt / static_cast<float>(substeps);
   const float inv_n = 1.0f / static_cast<float>(substeps);
-  const int stride = params_.collision_stride;
+  const int stride = collisionStrideFor(params_.collision_stride, particleCount());
   int span0 = 0;
   bool predicted = false;  // substep s's prediction already ran, fused into s - 1's last loop
   for (int s = 0; s < substeps; ++s) {

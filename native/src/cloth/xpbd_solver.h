@@ -35,8 +35,9 @@ struct XpbdParams {
   Vec3 wind = Vec3::Zero();       // m/s
   float max_speed = 20.0f;        // m/s, speed clamp after integration; <= 0: none
   CollisionParams collision;      // used when a collider is set
-  // Collision every this many substeps (and always on the last), [1, 8]: the swept test and
-  // friction then span the substeps in between. 1 = every substep.
+  // Collision every this many substeps (and always on the last), [0, 8]: the swept test and
+  // friction then span the substeps in between. 1 = every substep; 0 = by the garment's
+  // resolution (collisionStrideFor).
   int collision_stride = 1;
   // Constraint projection passes per substep, [1, 64]. 1 is the method (many substeps of one
   // iteration); more passes exist to price that choice (drape-bench, docs/benchmarks.md) and for
@@ -55,6 +56,21 @@ struct XpbdParams {
   float strain_limit = 0.0f;
   int strain_limit_passes = 2;  // [1, 16]
 };
+
+// The collision stride a cloth of `particles` particles runs: `stride` when it is set (1-8); for 0
+// (automatic) every substep up to kCollideEverySubstepMaxParticles particles and every second one
+// above. Why: colliding every second substep, a coarse garment's sleeves and trouser legs come
+// off the limbs in many more frames (the quality matrix at 400-1 200 particles: 3 118 frames with
+// an opening off against 1 251 colliding every substep), and up to 1 250 particles collision every
+// substep costs at most about 15 % more than the default resolution (1 809 particles) costs
+// every second substep; finer garments lose fewer frames and it would cost them 35-45 % of the
+// frame (docs/garments.md, "Coarse garments collide every substep"). The CPU and OpenCL solvers
+// both resolve it here, so they run the same stride.
+constexpr size_t kCollideEverySubstepMaxParticles = 1250;
+inline int collisionStrideFor(int stride, size_t particles) {
+  if (stride > 0) return stride;
+  return particles <= kCollideEverySubstepMaxParticles ? 1 : 2;
+}
 
 // Wall-clock split of the last step (only measured when enabled, for benchmarks): constraints =
 // prediction, projection and velocity update; collision = per-substep collider setup + collide().

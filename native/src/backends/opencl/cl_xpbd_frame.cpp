@@ -87,7 +87,7 @@ bool ClXpbdSolver::prepareFrame(float dt, int substeps) {
   const float h = dt / static_cast<float>(substeps);
   const float inv_h2 = 1.0f / (h * h);
   const int count = static_cast<int>(motion_start_.size());
-  const int stride = params_.collision_stride;
+  const int stride = collisionStrideFor(params_.collision_stride, n);
   if (count > 0) {
     packFrameShapes(motion_start_.data(), motion_end_.data(), count, motion_margin_, groups_, substeps, stride,
                     shapes_, bounds_);
