@@ -478,10 +478,13 @@ TEST(ClothXpbd, AtRestNothingMovesAndPaddingStaysHidden) {
 }
 
 TEST(ClothXpbd, CollisionStrideByResolution) {
-  // 0: every substep up to kCollideEverySubstepMaxParticles particles, every second one above; a
-  // stride that is set is kept whatever the resolution.
+  // 0: every substep from kCollideEverySubstepMinParticles to kCollideEverySubstepMaxParticles
+  // particles, every second one outside; a stride that is set is kept whatever the resolution.
+  EXPECT_EQ(kCollideEverySubstepMinParticles, 300u);
   EXPECT_EQ(kCollideEverySubstepMaxParticles, 1250u);
-  EXPECT_EQ(collisionStrideFor(0, 1), 1);
+  EXPECT_EQ(collisionStrideFor(0, 1), 2);
+  EXPECT_EQ(collisionStrideFor(0, 299), 2);
+  EXPECT_EQ(collisionStrideFor(0, 300), 1);
   EXPECT_EQ(collisionStrideFor(0, 1250), 1);
   EXPECT_EQ(collisionStrideFor(0, 1251), 2);
   EXPECT_EQ(collisionStrideFor(0, 32000), 2);

@@ -649,8 +649,8 @@ namespace Drape
         public float StrainLimit;
         /// <summary>collision_stride: XPBD, collide with the ellipsoids every Nth substep (the swept
         /// test spans the N substeps), [0, 8]; default 0: by the garment's resolution, every substep
-        /// for at most 1 250 particles (coarse sleeves and trouser legs otherwise come off the limbs)
-        /// and every second one above. 1 costs about twice the collision time of 2. The mass-spring
+        /// for 300 to 1 250 particles (coarse sleeves and trouser legs otherwise come off the limbs)
+        /// and every second one outside. 1 costs about twice the collision time of 2. The mass-spring
         /// solver collides every substep and ignores it. Added after the rest (the struct grew from
         /// 128 to 132 bytes); the library still accepts the 128-byte layout.</summary>
         public uint CollisionStride;

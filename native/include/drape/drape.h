@@ -536,10 +536,10 @@ typedef struct drape_cloth_params {
    * (128, the layout without it) are accepted and get its default. */
   uint32_t collision_stride;   /* XPBD: collide with the ellipsoids every Nth substep (the swept
                                   test spans the N substeps), [0, 8]; 0 (default): by the garment's
-                                  resolution, every substep for at most 1 250 particles (coarse
+                                  resolution, every substep for 300 to 1 250 particles (coarse
                                   sleeves and trouser legs otherwise come off the limbs) and every
-                                  second one above (docs/garments.md, "Coarse garments collide every
-                                  substep"). 1 costs about twice the collision time of 2. The
+                                  second one outside (docs/garments.md, "Coarse garments collide
+                                  every substep"). 1 costs about twice the collision time of 2. The
                                   mass-spring solver collides every substep and ignores it */
 } drape_cloth_params;
 

@@ -49,7 +49,7 @@ struct GarmentSimParams {
   // Collision runs every second substep (150 Hz at the default 300 Hz; the swept test covers the
   // two substeps): collision cost halves and stretch, penetration and particles inside stay
   // within the run-to-run noise on the shared takes; every third substep made the 120 Hz BVH
-  // takes (3 substeps a frame) unstable (docs/garments.md). A garment of at most 1 250 particles
+  // takes (3 substeps a frame) unstable (docs/garments.md). A garment of 300 to 1 250 particles
   // collides every substep (collision_stride 0, collisionStrideFor in cloth/xpbd_solver.h): its
   // coarse sleeves came off the arms (docs/garments.md, "Coarse garments collide every substep").
   // The strain limit (10 %, two passes at the end of each step, XpbdParams::strain_limit): on the
