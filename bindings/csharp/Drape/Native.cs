@@ -123,8 +123,10 @@ namespace Drape
         [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
         internal static extern ResultCode drape_garment_template_init(GarmentTemplate* tmpl);
 
+        /// <summary>The sized init (the exported drape_cloth_params_init fills the first 128-byte
+        /// layout only, for hosts built before collision_stride).</summary>
         [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
-        internal static extern ResultCode drape_cloth_params_init(ClothParams* parameters);
+        internal static extern ResultCode drape_cloth_params_init_sized(ClothParams* parameters, uint structSize);
 
         /// <param name="context">drape_context*.</param>
         /// <param name="desc">optional (NULL: defaults).</param>

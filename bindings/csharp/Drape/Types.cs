@@ -662,12 +662,13 @@ namespace Drape
             set => ContinuousCollision = value ? 1u : 0u;
         }
 
-        /// <summary>The library's defaults (drape_cloth_params_init).</summary>
+        /// <summary>The library's defaults (drape_cloth_params_init_sized with this struct's size,
+        /// as the C header's drape_cloth_params_init).</summary>
         public static unsafe ClothParams CreateDefault()
         {
             DrapeLibrary.EnsureCompatible();
             ClothParams p;
-            DrapeException.Check(Native.drape_cloth_params_init(&p));
+            DrapeException.Check(Native.drape_cloth_params_init_sized(&p, (uint)sizeof(ClothParams)));
             return p;
         }
     }

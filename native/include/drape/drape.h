@@ -11,7 +11,11 @@
  *    (sets defaults and struct_size) and then change the fields you need. A struct_size smaller than
  *    the first released version of the struct is rejected, so uninitialised structs are caught;
  *    fields added to a struct later are appended, and a caller built with the earlier header
- *    (a smaller struct_size) gets their defaults.
+ *    (a smaller struct_size) gets their defaults. An init function fills sizeof of the library's
+ *    struct, more than such a caller has, so a struct that grows keeps its exported `_init` at the
+ *    size it had and gains an `_init_sized` that this header's `_init` maps to with the caller's
+ *    sizeof (drape_cloth_params since collision_stride; drape_context_desc_init still fills its
+ *    whole 72 bytes, 8 more than a caller of its 64-byte first layout has).
  *  - Buffers: the caller allocates and passes (pointer, capacity); the library writes and never keeps
  *    the pointer. Size queries tell the capacity needed. Nothing the caller owns is modified when a
  *    call fails.
@@ -546,7 +550,20 @@ typedef struct drape_cloth_params {
 /* sizeof(drape_cloth_params) before collision_stride. */
 #define DRAPE_CLOTH_PARAMS_SIZE_V1 128u
 
+/* Fills the first `struct_size` bytes of `params` with the defaults and sets params->struct_size to
+ * it; nothing past them is written. struct_size from DRAPE_CLOTH_PARAMS_SIZE_V1 to this library's
+ * sizeof(drape_cloth_params); outside: DRAPE_ERROR_INVALID_ARGUMENT (a size above it is a header
+ * newer than the library) and nothing written. Call it through drape_cloth_params_init below. */
+DRAPE_API drape_result DRAPE_CALL drape_cloth_params_init_sized(drape_cloth_params* params, uint32_t struct_size);
+/* The exported drape_cloth_params_init fills the first layout only (DRAPE_CLOTH_PARAMS_SIZE_V1 bytes,
+ * struct_size 128): a host built before collision_stride calls it with a 128-byte struct, which the
+ * library's larger struct must not overrun. Code built with this header calls the sized init with
+ * its own sizeof instead, through the inline function and macro below. */
 DRAPE_API drape_result DRAPE_CALL drape_cloth_params_init(drape_cloth_params* params);
+static inline drape_result drape_cloth_params_init_current(drape_cloth_params* params) {
+  return drape_cloth_params_init_sized(params, (uint32_t)sizeof(drape_cloth_params));
+}
+#define drape_cloth_params_init drape_cloth_params_init_current
 
 /* Adds a template garment, dressed on the body's rest pose (~ms per 1 000 particles). desc and
  * cloth may be NULL for defaults. On success *out_garment is a new handle owned by the context.

@@ -307,11 +307,28 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_template_init(drape_garment_temp
   return DRAPE_OK;
 }
 
+DRAPE_API drape_result DRAPE_CALL drape_cloth_params_init_sized(drape_cloth_params* params, uint32_t struct_size) {
+  static const char* fn = "drape_cloth_params_init_sized";
+  if (!params) return fail(DRAPE_ERROR_NULL_ARGUMENT, std::string(fn) + ": params is NULL");
+  if (struct_size < DRAPE_CLOTH_PARAMS_SIZE_V1 || struct_size > sizeof(drape_cloth_params)) {
+    return fail(DRAPE_ERROR_INVALID_ARGUMENT,
+                std::string(fn) + ": struct_size is " + std::to_string(struct_size) + ", expected " +
+                    std::to_string(DRAPE_CLOTH_PARAMS_SIZE_V1) + " to " + std::to_string(sizeof(drape_cloth_params)) +
+                    " (a larger one comes from a header newer than this library)");
+  }
+  drape_cloth_params c;
+  c.struct_size = struct_size;
+  fromSimParams(drape::GarmentSimParams{}, c);
+  std::memcpy(params, &c, struct_size);
+  return DRAPE_OK;
+}
+
+// The header maps drape_cloth_params_init to the sized init with the caller's sizeof; this is the
+// exported symbol hosts built before collision_stride call: the first layout's 128 bytes.
+#undef drape_cloth_params_init
 DRAPE_API drape_result DRAPE_CALL drape_cloth_params_init(drape_cloth_params* params) {
   if (!params) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_cloth_params_init: params is NULL");
-  params->struct_size = sizeof(drape_cloth_params);
-  fromSimParams(drape::GarmentSimParams{}, *params);
-  return DRAPE_OK;
+  return drape_cloth_params_init_sized(params, DRAPE_CLOTH_PARAMS_SIZE_V1);
 }
 
 DRAPE_API drape_result DRAPE_CALL drape_mesh_fit_init(drape_mesh_fit* fit) {
