@@ -123,10 +123,15 @@ namespace Drape
         [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
         internal static extern ResultCode drape_garment_template_init(GarmentTemplate* tmpl);
 
-        /// <summary>The sized init (the exported drape_cloth_params_init fills the first 128-byte
-        /// layout only, for hosts built before collision_stride).</summary>
+        /// <summary>The sized init, which <see cref="ClothParams.CreateDefault"/> calls with the
+        /// struct's own size.</summary>
         [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
         internal static extern ResultCode drape_cloth_params_init_sized(ClothParams* parameters, uint structSize);
+
+        /// <summary>The exported first-layout init: fills 128 bytes (struct_size 128), for hosts built
+        /// before collision_stride. Declared because every drape.h function is; not called.</summary>
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_cloth_params_init(ClothParams* parameters);
 
         /// <param name="context">drape_context*.</param>
         /// <param name="desc">optional (NULL: defaults).</param>
