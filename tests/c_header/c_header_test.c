@@ -103,6 +103,15 @@ int main(void) {
   CHECK(desc.struct_size == sizeof(drape_context_desc));
   CHECK(desc.arms_clear_torso == 1);
   CHECK(offsetof(drape_context_desc, arms_clear_torso) == DRAPE_CONTEXT_DESC_SIZE_V1);
+  /* The sized init writes only the size it is given (a first-layout host's 64 bytes). */
+  {
+    drape_context_desc first;
+    memset(&first, 0x5A, sizeof(first));
+    CHECK_OK(drape_context_desc_init_sized(&first, DRAPE_CONTEXT_DESC_SIZE_V1));
+    CHECK(first.struct_size == DRAPE_CONTEXT_DESC_SIZE_V1);
+    CHECK(first.ring_points == desc.ring_points);
+    CHECK(first.arms_clear_torso == 0x5A5A5A5A);
+  }
   CHECK(offsetof(drape_cloth_params, collision_stride) == DRAPE_CLOTH_PARAMS_SIZE_V1);
   CHECK(sizeof(drape_cloth_params) == DRAPE_CLOTH_PARAMS_SIZE_V1 + 4);
   CHECK_OK(drape_context_create(&desc, &ctx));

@@ -134,6 +134,20 @@ struct Machine {
       d.arms_clear_torso = static_cast<int32_t>(in.u8() % 3);  // 2 is out of range
       d.arm_torso_clearance_m = in.inRange(-0.01f, 0.06f);     // [0, 0.05] in range
     }
+    if (mode & 128) {
+      // The sized init over the desc drawn so far: sizes round the first layout's 64 and this
+      // header's 72 (outside [64, 72]: refused, nothing written; inside: the fields the size
+      // covers back to their defaults, struct_size that size).
+      const uint32_t size = 60 + in.u8() % 16u;
+      const drape_context_desc before = d;
+      const drape_result r = DRAPE_FUZZ_CALL(drape_context_desc_init_sized(&d, size));
+      const bool in_range = size >= DRAPE_CONTEXT_DESC_SIZE_V1 && size <= sizeof(d);
+      DRAPE_FUZZ_CHECK((r == DRAPE_OK) == in_range, "the sized init takes exactly the sizes it documents");
+      DRAPE_FUZZ_CHECK(std::memcmp(reinterpret_cast<const unsigned char*>(&d) + (in_range ? size : 0),
+                                   reinterpret_cast<const unsigned char*>(&before) + (in_range ? size : 0),
+                                   sizeof(d) - (in_range ? size : 0)) == 0,
+                       "the sized init writes nothing past the size it is given");
+    }
     drape_context* h = nullptr;
     if (DRAPE_FUZZ_CALL(drape_context_create((mode & 16) && (mode & 32) ? nullptr : &d, &h)) == DRAPE_OK) {
       DRAPE_FUZZ_CHECK(h != nullptr, "create OK gives a handle");

@@ -27,7 +27,7 @@ constexpr const char* kWaveHand = "kinect_v2_msft_labanotation/Ges01_wavehand.cs
 
 // Puts a known message into this thread's last error so that a later check can tell the message
 // was written by the call under test (and not left over from an earlier failure).
-const char* const kPrimeMessage = "drape_context_desc_init: desc is NULL";
+const char* const kPrimeMessage = "drape_context_desc_init_sized: desc is NULL";
 void primeLastError() {
   ASSERT_EQ(drape_context_desc_init(nullptr), DRAPE_ERROR_NULL_ARGUMENT);
   ASSERT_STREQ(drape_last_error(), kPrimeMessage);
@@ -52,8 +52,9 @@ drape_backend_info backendInfo(drape_context* ctx) {
 // message must also name that function.
 ::testing::AssertionResult failsWith(drape_result code, const char* fn, const std::function<drape_result()>& call,
                                      const char* text) {
-  // Prime with a message that names a different function (desc_init primes for everything else).
-  if (fn && std::strcmp(fn, "drape_context_desc_init") == 0) {
+  // Prime with a message that names a different function (desc_init primes for everything else;
+  // the header maps it to drape_context_desc_init_sized, whose name it also prefixes).
+  if (fn && std::strncmp(fn, "drape_context_desc_init", std::strlen("drape_context_desc_init")) == 0) {
     (void)drape_body_shape_init(nullptr);
   } else {
     (void)drape_context_desc_init(nullptr);

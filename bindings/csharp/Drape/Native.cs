@@ -53,6 +53,13 @@ namespace Drape
 
         // ---- Context ---------------------------------------------------------------------------
 
+        /// <summary>The sized init, which <see cref="ContextDesc.CreateDefault"/> calls with the
+        /// struct's own size.</summary>
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_context_desc_init_sized(ContextDesc* desc, uint structSize);
+
+        /// <summary>The exported init of the struct's 72-byte layout, for hosts built before the
+        /// sized init. Declared because every drape.h function is; not called.</summary>
         [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
         internal static extern ResultCode drape_context_desc_init(ContextDesc* desc);
 

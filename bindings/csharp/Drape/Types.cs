@@ -328,12 +328,13 @@ namespace Drape
             set => ArmsClearTorso = value ? 1 : 0;
         }
 
-        /// <summary>The library's defaults (drape_context_desc_init).</summary>
+        /// <summary>The library's defaults (drape_context_desc_init_sized with this struct's size,
+        /// so a library whose struct has grown never writes past it).</summary>
         public static unsafe ContextDesc CreateDefault()
         {
             DrapeLibrary.EnsureCompatible();
             ContextDesc d;
-            DrapeException.Check(Native.drape_context_desc_init(&d));
+            DrapeException.Check(Native.drape_context_desc_init_sized(&d, (uint)sizeof(ContextDesc)));
             return d;
         }
     }

@@ -14,8 +14,9 @@
  *    (a smaller struct_size) gets their defaults. An init function fills sizeof of the library's
  *    struct, more than such a caller has, so a struct that grows keeps its exported `_init` at the
  *    size it had and gains an `_init_sized` that this header's `_init` maps to with the caller's
- *    sizeof (drape_cloth_params since collision_stride; drape_context_desc_init still fills its
- *    whole 72 bytes, 8 more than a caller of its 64-byte first layout has).
+ *    sizeof (drape_cloth_params since collision_stride; drape_context_desc, whose exported init
+ *    fills the 72 bytes the struct had when its sized init came: 8 more than a host built against
+ *    its 64-byte first layout has, a hazard left only to such old binaries).
  *  - Buffers: the caller allocates and passes (pointer, capacity); the library writes and never keeps
  *    the pointer. Size queries tell the capacity needed. Nothing the caller owns is modified when a
  *    call fails.
@@ -207,8 +208,20 @@ typedef struct drape_context_desc {
 /* sizeof(drape_context_desc) before arms_clear_torso and arm_torso_clearance_m. */
 #define DRAPE_CONTEXT_DESC_SIZE_V1 64u
 
-/* Fills `desc` with defaults and struct_size. */
+/* Fills the first `struct_size` bytes of `desc` with the defaults and sets desc->struct_size to it;
+ * nothing past them is written. struct_size from DRAPE_CONTEXT_DESC_SIZE_V1 to this library's
+ * sizeof(drape_context_desc); outside: DRAPE_ERROR_INVALID_ARGUMENT (a size above it is a header
+ * newer than the library) and nothing written. Call it through drape_context_desc_init below. */
+DRAPE_API drape_result DRAPE_CALL drape_context_desc_init_sized(drape_context_desc* desc, uint32_t struct_size);
+/* The exported drape_context_desc_init fills the struct's second layout (72 bytes, struct_size 72),
+ * what hosts built before the sized init have; it stays at that size when the struct grows. Code
+ * built with this header calls the sized init with its own sizeof instead, through the inline
+ * function and macro below. */
 DRAPE_API drape_result DRAPE_CALL drape_context_desc_init(drape_context_desc* desc);
+static inline drape_result drape_context_desc_init_current(drape_context_desc* desc) {
+  return drape_context_desc_init_sized(desc, (uint32_t)sizeof(drape_context_desc));
+}
+#define drape_context_desc_init drape_context_desc_init_current
 
 /* Creates a context: one tracked person and (from later versions) their garments. The body starts
  * with the default shape (drape_body_shape_init). `desc` may be NULL for all defaults. On success

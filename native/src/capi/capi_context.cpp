@@ -34,28 +34,49 @@ drape_result toShapeInput(const drape_body_shape& s, drape::BodyShapeInput& in) 
 
 extern "C" {
 
+DRAPE_API drape_result DRAPE_CALL drape_context_desc_init_sized(drape_context_desc* desc, uint32_t struct_size) {
+  static const char* fn = "drape_context_desc_init_sized";
+  if (!desc) return fail(DRAPE_ERROR_NULL_ARGUMENT, std::string(fn) + ": desc is NULL");
+  if (struct_size < DRAPE_CONTEXT_DESC_SIZE_V1 || struct_size > sizeof(drape_context_desc)) {
+    return fail(DRAPE_ERROR_INVALID_ARGUMENT,
+                std::string(fn) + ": struct_size is " + std::to_string(struct_size) + ", expected " +
+                    std::to_string(DRAPE_CONTEXT_DESC_SIZE_V1) + " to " + std::to_string(sizeof(drape_context_desc)) +
+                    " (a larger one comes from a header newer than this library)");
+  }
+  drape_context_desc d;
+  std::memset(&d, 0, sizeof(d));
+  const drape::TrackerParams t;
+  d.struct_size = struct_size;
+  d.ring_points = 20;
+  d.rings_per_segment = 1;
+  d.calibration_frames = static_cast<uint32_t>(t.calibration_frames);
+  d.filter = DRAPE_FILTER_ONE_EURO;
+  d.filter_min_cutoff_hz = t.min_cutoff_hz;
+  d.filter_beta = t.beta;
+  d.filter_d_cutoff_hz = t.d_cutoff_hz;
+  d.smoothing = t.smoothing;
+  d.correction = t.correction;
+  d.prediction = t.prediction;
+  d.jitter_radius_m = t.jitter_radius_m;
+  d.max_deviation_m = t.max_deviation_m;
+  d.teleport_distance_m = t.teleport_distance_m;
+  d.proxy_rule = DRAPE_PROXY_RULE_DRAPE;
+  d.arms_clear_torso = 1;
+  d.arm_torso_clearance_m = drape::kDefaultArmTorsoClearanceM;
+  std::memcpy(desc, &d, struct_size);
+  return DRAPE_OK;
+}
+
+// The header maps drape_context_desc_init to the sized init with the caller's sizeof; this is the
+// exported symbol that hosts built before the sized init call: the 72 bytes the struct had then
+// (8 more than a host of the 64-byte first layout, older still, has: drape.h's conventions).
+#undef drape_context_desc_init
+constexpr uint32_t kContextDescSizeOfTheExportedInit = 72;
+static_assert(sizeof(drape_context_desc) >= kContextDescSizeOfTheExportedInit,
+              "the exported init's layout is a prefix of the struct");
 DRAPE_API drape_result DRAPE_CALL drape_context_desc_init(drape_context_desc* desc) {
   if (!desc) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_desc_init: desc is NULL");
-  std::memset(desc, 0, sizeof(*desc));
-  const drape::TrackerParams t;
-  desc->struct_size = sizeof(drape_context_desc);
-  desc->ring_points = 20;
-  desc->rings_per_segment = 1;
-  desc->calibration_frames = static_cast<uint32_t>(t.calibration_frames);
-  desc->filter = DRAPE_FILTER_ONE_EURO;
-  desc->filter_min_cutoff_hz = t.min_cutoff_hz;
-  desc->filter_beta = t.beta;
-  desc->filter_d_cutoff_hz = t.d_cutoff_hz;
-  desc->smoothing = t.smoothing;
-  desc->correction = t.correction;
-  desc->prediction = t.prediction;
-  desc->jitter_radius_m = t.jitter_radius_m;
-  desc->max_deviation_m = t.max_deviation_m;
-  desc->teleport_distance_m = t.teleport_distance_m;
-  desc->proxy_rule = DRAPE_PROXY_RULE_DRAPE;
-  desc->arms_clear_torso = 1;
-  desc->arm_torso_clearance_m = drape::kDefaultArmTorsoClearanceM;
-  return DRAPE_OK;
+  return drape_context_desc_init_sized(desc, kContextDescSizeOfTheExportedInit);
 }
 
 DRAPE_API drape_result DRAPE_CALL drape_context_create(const drape_context_desc* desc,
@@ -63,7 +84,7 @@ DRAPE_API drape_result DRAPE_CALL drape_context_create(const drape_context_desc*
   return guarded("drape_context_create", [&]() -> drape_result {
     if (!out_context) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_create: out_context is NULL");
     drape_context_desc d;
-    drape_context_desc_init(&d);
+    drape_context_desc_init_sized(&d, sizeof(d));
     if (desc) {
       if (drape_result r = checkStructSize(desc->struct_size, DRAPE_CONTEXT_DESC_SIZE_V1, "drape_context_desc"))
         return r;
