@@ -77,7 +77,10 @@ foreach(path "drape_version" "recording" "format" "layout" "frames" "rejected_fr
              "stages_ms|cloth" "stages_ms|integrate" "stages_ms|collide" "stages_ms|frame" "particles"
              "garment|kind" "garment|source" "garment|solver" "garment|substep_hz" "garment|iterations" "garment|triangles"
              "garment|edges" "garment|attached" "garment|frames_stepped" "garment|max_stretch"
-             "garment|p99_stretch" "garment|proxy_inside" "garment|body_penetration_mm|p99"
+             "garment|p99_stretch" "garment|body_surface_stretch|edges" "garment|body_surface_stretch|p99"
+             "garment|body_surface_stretch|max" "garment|body_surface_stretch|over_5pct"
+             "garment|body_surface_stretch|tubes|edges" "garment|body_surface_stretch|tubes|p99"
+             "garment|body_surface_stretch|tubes|over_5pct" "garment|proxy_inside" "garment|body_penetration_mm|p99"
              "garment|body_penetration_mm|max" "garment|deeper_than_2mm" "garment|openings|tracked"
              "garment|openings|off_frames" "garment|openings|off_max" "garment|frames_measured"
              "garment|teleport_resets" "garment|nan_resets" "garment|contacts" "garment|substeps"
@@ -192,7 +195,9 @@ if(NOT _source STREQUAL EXPECT_GARMENT)
   string(APPEND _failures "  garment.source = ${_source}, expected ${EXPECT_GARMENT}\n")
 endif()
 set(_garment_numbers "stages_ms|cloth" "stages_ms|integrate" "stages_ms|collide" "garment|substep_hz"
-    "garment|max_stretch" "garment|p99_stretch" "garment|contacts" "garment|substeps")
+    "garment|max_stretch" "garment|p99_stretch" "garment|body_surface_stretch|p99"
+    "garment|body_surface_stretch|over_5pct" "garment|body_surface_stretch|tubes|p99" "garment|contacts"
+    "garment|substeps")
 set(_garment_measured "garment|body_penetration_mm|p99" "garment|body_penetration_mm|max"
     "garment|deeper_than_2mm")
 expect_type(NUMBER stages_ms frame)
@@ -221,6 +226,13 @@ else()
     string(REPLACE "|" ";" _keys "${path}")
     expect_type(NUMBER ${_keys})
   endforeach()
+  # The body's surface under the garment: some of the body's edges, the tubes' a part of them.
+  json_get(_bs_edges garment body_surface_stretch edges)
+  json_get(_bs_tubes garment body_surface_stretch tubes edges)
+  if(NOT _bs_edges GREATER 0 OR NOT _bs_tubes GREATER 0 OR _bs_tubes GREATER _bs_edges)
+    string(APPEND _failures "  garment.body_surface_stretch: ${_bs_edges} edges, ${_bs_tubes} of them the tubes'; "
+                            "expected 0 < tubes <= edges\n")
+  endif()
   json_get(_gmeasured garment frames_measured)
   if(DEFINED EXPECT_MEASURED)
     expect_equal("garment.frames_measured" "${_gmeasured}" "${EXPECT_MEASURED}")

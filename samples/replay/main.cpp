@@ -265,6 +265,10 @@ int run(int argc, char** argv) {
   // Outputs: create directories before spending time on the replay.
   const std::string stats_path = replay::resolveStatsPath(opt);
   const uint32_t frames = opt.max_frames == 0 ? info.frame_count : std::min(opt.max_frames, info.frame_count);
+  // The body's surface stretch is measured against the body once its bone lengths are calibrated
+  // (before that the body's proportions are still being measured), or the last frame's of a
+  // shorter run.
+  st.body_stretch_from_frame = frames == 0 ? 0u : std::min(desc.calibration_frames, frames - 1);
   const bool render_due = replay::resolveRenderEvery(opt, frames) != 0;
   if ((opt.write_obj || render_due) && !ensureDirectory(opt.out_dir, error)) return fail(kExitUsage, error);
   if (!stats_path.empty() && !ensureDirectory(fs::path(stats_path).parent_path(), error))
@@ -503,6 +507,18 @@ int run(int argc, char** argv) {
                                     libraryReason(r));
     st.nonfinite += replay::countNonFinite(garment_positions) + replay::countNonFinite(garment_normals);
     st.stretch.addFrame(garment_positions);
+    if (!st.body_stretch_set && i >= st.body_stretch_from_frame) {
+      const std::vector<uint32_t> under = replay::trianglesNear(
+          indices, positions, garment_positions, replay::ReplayStats::kBodyUnderGarmentM,
+          replay::ReplayStats::kBodyMinEdgeM);
+      st.body_stretch.setMesh(under, positions);
+      st.body_tube_stretch.setMesh(under, positions, st.ring_points + 1);
+      st.body_stretch_set = true;
+    }
+    if (st.body_stretch_set) {
+      st.body_stretch.addFrame(positions);
+      st.body_tube_stretch.addFrame(positions);
+    }
 
     if (opt.write_obj) {
       const fs::path obj = fs::path(opt.out_dir) / replay::garmentObjFileName(i);

@@ -213,6 +213,18 @@ std::string statsJson(const ReplayStats& s) {
   w.key("frames_stepped").value(static_cast<uint32_t>(s.cloth_ms.size()));
   w.key("max_stretch").value(s.stretch.max());
   w.key("p99_stretch").value(s.stretch.percentile(99.0));
+  w.key("body_surface_stretch").beginObject();
+  w.key("from_frame").value(s.body_stretch_from_frame);
+  w.key("edges").value(static_cast<int64_t>(s.body_stretch.edgeCount()));
+  w.key("p99").value(s.body_stretch.percentile(99.0));
+  w.key("max").value(s.body_stretch.max());
+  w.key("over_5pct").value(s.body_stretch.fractionAbove(0.05));
+  w.key("tubes").beginObject();
+  w.key("edges").value(static_cast<int64_t>(s.body_tube_stretch.edgeCount()));
+  w.key("p99").value(s.body_tube_stretch.percentile(99.0));
+  w.key("over_5pct").value(s.body_tube_stretch.fractionAbove(0.05));
+  w.endObject();
+  w.endObject();
   w.key("proxy_inside").value(static_cast<int64_t>(s.proxy_inside));
   w.key("body_penetration_mm").beginObject();
   w.key("p99").value(maximum(s.penetration_p99_mm));
@@ -309,6 +321,12 @@ std::string summaryText(const ReplayStats& s, const std::string& obj_dir, const 
         s.backend_fallback.empty() ? "" : " (OpenCL not used: ", s.backend_fallback.empty() ? "" : (s.backend_fallback + ")").c_str());
     appendf(o, "stretch     max %.2f %%, P99 %.2f %% (%zu edges x %zu frames pooled)\n", 100.0 * s.stretch.max(),
         100.0 * s.stretch.percentile(99.0), s.stretch.edgeCount(), s.cloth_ms.size());
+    if (s.body_stretch.edgeCount() > 0)
+      appendf(o, "            the body's own surface under it, against frame %u: P99 %.2f %%, %.2f %% of "
+                 "samples over 5 %% (%zu edges); its tubes without the stitches: P99 %.2f %%, %.2f %% over 5 %%\n",
+          s.body_stretch_from_frame, 100.0 * s.body_stretch.percentile(99.0), 100.0 * s.body_stretch.fractionAbove(0.05),
+          s.body_stretch.edgeCount(), 100.0 * s.body_tube_stretch.percentile(99.0),
+          100.0 * s.body_tube_stretch.fractionAbove(0.05));
     if (!s.penetration_p99_mm.empty())
       appendf(o, "inside      %llu particle-frames inside an ellipsoid; body penetration P99 %.2f mm (worst frame), "
                  "max %.2f mm; %.3f %% deeper than 2 mm (mean of %zu measured frames)\n",

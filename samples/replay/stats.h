@@ -83,6 +83,20 @@ struct ReplayStats {
   std::vector<double> device_upload_ms, device_kernel_ms, device_readback_ms, device_host_ms;
   // Stretch of every structural edge of every stepped frame, from the positions read back.
   StretchAccumulator stretch;
+  // The body's own surface stretch under the garment: the body mesh's edges of the triangles
+  // within kBodyUnderGarmentM of the garment on the first stepped frame from
+  // body_stretch_from_frame (the context's calibration_frames: the bones calibrated), against
+  // their length on that frame, every stepped frame from then on (what a garment that followed
+  // the body's surface without sliding would stretch; docs/replay.md).
+  static constexpr float kBodyUnderGarmentM = 0.04f;
+  static constexpr float kBodyMinEdgeM = 0.002f;  // degenerate stitch triangles left out
+  StretchAccumulator body_stretch;
+  // The same edges but the stitches between tubes (vertex indices more than ring_points + 1
+  // apart: the mesh stores its vertices ring by ring, docs/body-model.md), whose triangles bridge
+  // the arm's and the torso's rings at the shoulders and stretch the most.
+  StretchAccumulator body_tube_stretch;
+  bool body_stretch_set = false;
+  uint32_t body_stretch_from_frame = 0;
   // Per measured frame (drape_garment_measure, --measure-every).
   uint64_t proxy_inside = 0;       // summed over measured frames
   std::vector<double> penetration_p99_mm, penetration_max_mm, deeper_than_2mm;
