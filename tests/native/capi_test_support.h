@@ -85,6 +85,47 @@ drape_backend_info backendInfo(drape_context* ctx) {
 #define EXPECT_OK(call) EXPECT_EQ((call), DRAPE_OK) << #call << ": " << lastError()
 
 // ------------------------------------------------------------------------------------------
+// A grown struct's inits never write past the caller's struct (drape.h's struct convention): the
+// exported init fills `exported_size` bytes, the sized init the size it is given (from
+// `first_size`, the first layout's, to sizeof(T)) and every byte it fills is the default's; a size
+// outside that range, or a NULL struct, is refused with nothing written. Guard bytes after the
+// struct in a buffer show what was written. Fills `defaults` with the whole struct's defaults.
+template <class T>
+void expectInitsWriteOnlyTheirSize(drape_result (*sized)(T*, uint32_t), const char* sized_name,
+                                   drape_result (*exported)(T*), const char* exported_name, uint32_t first_size,
+                                   uint32_t exported_size, T& defaults) {
+  ASSERT_OK(sized(&defaults, static_cast<uint32_t>(sizeof(T))));
+  uint32_t defaults_size = 0;
+  std::memcpy(&defaults_size, &defaults, sizeof(defaults_size));
+  EXPECT_EQ(defaults_size, sizeof(T));
+  alignas(T) unsigned char buf[sizeof(T) + 16];
+  T* t = reinterpret_cast<T*>(buf);
+  auto expectFilled = [&](uint32_t size, const char* what) {
+    uint32_t written = 0;
+    std::memcpy(&written, buf, sizeof(written));
+    EXPECT_EQ(written, size) << what;
+    EXPECT_EQ(std::memcmp(buf + 4, reinterpret_cast<const unsigned char*>(&defaults) + 4, size - 4), 0) << what;
+    for (size_t k = size; k < sizeof(buf); ++k) ASSERT_EQ(buf[k], 0xAB) << what << ": byte " << k << " written";
+  };
+  std::memset(buf, 0xAB, sizeof(buf));
+  ASSERT_OK(exported(t));
+  expectFilled(exported_size, exported_name);
+  for (uint32_t size : {first_size, first_size + 4, exported_size, static_cast<uint32_t>(sizeof(T))}) {
+    if (size > sizeof(T)) continue;
+    std::memset(buf, 0xAB, sizeof(buf));
+    ASSERT_OK(sized(t, size));
+    expectFilled(size, sized_name);
+  }
+  for (uint32_t bad : {0u, first_size - 1, static_cast<uint32_t>(sizeof(T)) + 1, 0xFFFFFFFFu}) {
+    std::memset(buf, 0xAB, sizeof(buf));
+    EXPECT_FAILS(DRAPE_ERROR_INVALID_ARGUMENT, sized_name, sized(t, bad));
+    for (size_t k = 0; k < sizeof(buf); ++k) ASSERT_EQ(buf[k], 0xAB) << "byte " << k << " written for size " << bad;
+  }
+  EXPECT_FAILS(DRAPE_ERROR_NULL_ARGUMENT, sized_name, sized(nullptr, static_cast<uint32_t>(sizeof(T))));
+  EXPECT_FAILS(DRAPE_ERROR_NULL_ARGUMENT, exported_name, exported(nullptr));
+}
+
+// ------------------------------------------------------------------------------------------
 // RAII owners (the tests still call drape_*_destroy explicitly where that is what is tested).
 
 struct ContextDeleter {

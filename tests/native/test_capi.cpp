@@ -788,35 +788,12 @@ drape_result (*const kExportedContextDescInit)(drape_context_desc*) = &drape_con
 // struct make a context with the later fields' defaults.
 TEST(Capi, ContextDescInitNeverWritesPastTheCallersStruct) {
   drape_context_desc full;
-  ASSERT_OK(drape_context_desc_init(&full));
-  EXPECT_EQ(full.struct_size, sizeof(full));
+  expectInitsWriteOnlyTheirSize(&drape_context_desc_init_sized, "drape_context_desc_init_sized",
+                                kExportedContextDescInit, "drape_context_desc_init", DRAPE_CONTEXT_DESC_SIZE_V1,
+                                72u, full);
+  if (HasFatalFailure()) return;
   alignas(drape_context_desc) unsigned char buf[sizeof(drape_context_desc) + 16];
   auto* d = reinterpret_cast<drape_context_desc*>(buf);
-  auto expectFilled = [&](uint32_t size, const char* what) {
-    uint32_t written = 0;
-    std::memcpy(&written, buf, sizeof(written));
-    EXPECT_EQ(written, size) << what;
-    EXPECT_EQ(std::memcmp(buf + 4, reinterpret_cast<const unsigned char*>(&full) + 4, size - 4), 0) << what;
-    for (size_t k = size; k < sizeof(buf); ++k) ASSERT_EQ(buf[k], 0xAB) << what << ": byte " << k << " written";
-  };
-  std::memset(buf, 0xAB, sizeof(buf));
-  ASSERT_OK(kExportedContextDescInit(d));
-  expectFilled(72, "drape_context_desc_init as exported");
-  for (uint32_t size : {DRAPE_CONTEXT_DESC_SIZE_V1, DRAPE_CONTEXT_DESC_SIZE_V1 + 4,
-                        static_cast<uint32_t>(sizeof(drape_context_desc))}) {
-    std::memset(buf, 0xAB, sizeof(buf));
-    ASSERT_OK(drape_context_desc_init_sized(d, size));
-    expectFilled(size, "drape_context_desc_init_sized");
-  }
-  for (uint32_t bad : {0u, DRAPE_CONTEXT_DESC_SIZE_V1 - 1, static_cast<uint32_t>(sizeof(drape_context_desc)) + 1,
-                       0xFFFFFFFFu}) {
-    std::memset(buf, 0xAB, sizeof(buf));
-    EXPECT_FAILS(DRAPE_ERROR_INVALID_ARGUMENT, "drape_context_desc_init_sized", drape_context_desc_init_sized(d, bad));
-    for (size_t k = 0; k < sizeof(buf); ++k) ASSERT_EQ(buf[k], 0xAB) << "byte " << k << " written for size " << bad;
-  }
-  EXPECT_FAILS(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_desc_init_sized",
-               drape_context_desc_init_sized(nullptr, sizeof(drape_context_desc)));
-  EXPECT_FAILS(DRAPE_ERROR_NULL_ARGUMENT, "drape_context_desc_init", kExportedContextDescInit(nullptr));
   // A first-layout host: its 64 bytes filled by the sized init, guard bytes after them where the
   // later fields are (arms_clear_torso 0xABABABAB, out of range if it were read): accepted, and
   // the body the default desc's.

@@ -246,34 +246,12 @@ drape_result (*const kFirstLayoutClothParamsInit)(drape_cloth_params*) = &drape_
 // writes nothing. The first layout's params are accepted at creation, collision_stride defaulted.
 TEST(CApiGarments, ClothParamsInitNeverWritesPastTheCallersStruct) {
   drape_cloth_params full;
-  ASSERT_OK(drape_cloth_params_init(&full));
-  EXPECT_EQ(full.struct_size, sizeof(full));
+  expectInitsWriteOnlyTheirSize(&drape_cloth_params_init_sized, "drape_cloth_params_init_sized",
+                                kFirstLayoutClothParamsInit, "drape_cloth_params_init", DRAPE_CLOTH_PARAMS_SIZE_V1,
+                                DRAPE_CLOTH_PARAMS_SIZE_V1, full);
+  if (HasFatalFailure()) return;
   alignas(drape_cloth_params) unsigned char buf[sizeof(drape_cloth_params) + 16];
   auto* p = reinterpret_cast<drape_cloth_params*>(buf);
-  auto expectFilled = [&](uint32_t size, const char* what) {
-    uint32_t written = 0;
-    std::memcpy(&written, buf, sizeof(written));
-    EXPECT_EQ(written, size) << what;
-    EXPECT_EQ(std::memcmp(buf + 4, reinterpret_cast<const unsigned char*>(&full) + 4, size - 4), 0) << what;
-    for (size_t k = size; k < sizeof(buf); ++k) ASSERT_EQ(buf[k], 0xAB) << what << ": byte " << k << " written";
-  };
-  std::memset(buf, 0xAB, sizeof(buf));
-  ASSERT_OK(kFirstLayoutClothParamsInit(p));
-  expectFilled(DRAPE_CLOTH_PARAMS_SIZE_V1, "drape_cloth_params_init as exported");
-  for (uint32_t size : {DRAPE_CLOTH_PARAMS_SIZE_V1, static_cast<uint32_t>(sizeof(drape_cloth_params))}) {
-    std::memset(buf, 0xAB, sizeof(buf));
-    ASSERT_OK(drape_cloth_params_init_sized(p, size));
-    expectFilled(size, "drape_cloth_params_init_sized");
-  }
-  for (uint32_t bad : {0u, DRAPE_CLOTH_PARAMS_SIZE_V1 - 1, static_cast<uint32_t>(sizeof(drape_cloth_params)) + 1,
-                       0xFFFFFFFFu}) {
-    std::memset(buf, 0xAB, sizeof(buf));
-    EXPECT_FAILS(DRAPE_ERROR_INVALID_ARGUMENT, "drape_cloth_params_init_sized", drape_cloth_params_init_sized(p, bad));
-    for (size_t k = 0; k < sizeof(buf); ++k) ASSERT_EQ(buf[k], 0xAB) << "byte " << k << " written for size " << bad;
-  }
-  EXPECT_FAILS(DRAPE_ERROR_NULL_ARGUMENT, "drape_cloth_params_init_sized",
-               drape_cloth_params_init_sized(nullptr, sizeof(drape_cloth_params)));
-  EXPECT_FAILS(DRAPE_ERROR_NULL_ARGUMENT, "drape_cloth_params_init", kFirstLayoutClothParamsInit(nullptr));
   // A host of the first layout: its init, its struct, a garment made with them.
   std::memset(buf, 0xAB, sizeof(buf));
   ASSERT_OK(kFirstLayoutClothParamsInit(p));
