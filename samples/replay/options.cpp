@@ -471,7 +471,7 @@ std::string helpText() {
       "                        (default 0: every substep for a garment of 300 to 1 250\n"
       "                        particles, every second one outside)\n"
       "  --measure-every N     measure the garment's accuracy (stretch, ellipsoid and body\n"
-      "                        penetration; ~1 ms per 1 000 particles) every N frames (default 1;\n"
+      "                        penetration; ~0.6 ms per 1 000 particles) every N frames (default 1;\n"
       "                        0 = never). Alias: --garment-every\n"
       "  --out DIR             output directory for body_NNNNN.obj, garment_NNNNN.obj and stats.json\n"
       "                        (default ./drape-out; created if missing)\n"

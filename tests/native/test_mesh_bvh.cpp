@@ -415,6 +415,64 @@ TEST(TriangleBvh, DepthInsideFollowsTheWindingNumberWhereTheSignMisreads) {
   EXPECT_GT(misread, 0) << "no probe where the sign misreads: the test no longer exercises the fix";
 }
 
+// The batched depth (one ray direction, a grid of the triangles' projections) gives depthInside's
+// answer for every point: probes round the whole body and on its surface, points within 3 cm of
+// the shoulder stitches (where parts overlap), the mesh's vertices themselves (on the surface, on
+// edges every ray may graze), points outside the mesh's reach and non-finite ones; in the rest
+// pose and after a refit to another pose.
+TEST(TriangleBvh, DepthsInsideGivesDepthInsideForEveryPoint) {
+  BodyModel body = restBody();
+  TriangleBvh bvh;
+  ASSERT_TRUE(bvh.build(body.positions(), body.indices()));
+  for (int pose = 0; pose < 2; ++pose) {
+    if (pose == 1) {
+      body.update(movedPose(body.shape()));
+      ASSERT_TRUE(bvh.refit(body.positions()));
+    }
+    const auto& P = body.positions();
+    const auto& I = body.indices();
+    std::vector<Vec3> points = probePoints(P, I, test::repeatsUnderSanitizers(6000, 6), 71 + static_cast<unsigned>(pose));
+    for (bool left : {true, false}) {
+      const std::vector<uint32_t>& T = body.shoulderTriangles(left);
+      for (size_t k = 0; k + 2 < T.size(); k += 3)
+        points.push_back((P[T[k]] + P[T[k + 1]] + P[T[k + 2]]) / 3.0f + 0.01f * Vec3(0.3f, -0.5f, 0.8f));
+    }
+    for (size_t k = 0; k < P.size(); k += 3) points.push_back(P[k]);
+    points.push_back(Vec3(10.0f, 10.0f, 10.0f));
+    points.push_back(Vec3::Constant(std::numeric_limits<float>::quiet_NaN()));
+    points.push_back(Vec3(std::numeric_limits<float>::infinity(), 0.0f, 0.0f));
+    std::vector<float> batched(points.size(), -1.0f);
+    bvh.depthsInside(points.data(), points.size(), batched.data());
+    int inside = 0;
+    for (size_t i = 0; i < points.size(); ++i) {
+      const float one = bvh.depthInside(points[i]);
+      ASSERT_EQ(batched[i], one) << "pose " << pose << ", point " << i << " at " << points[i].transpose();
+      inside += one > 0.0f;
+    }
+    EXPECT_GT(inside, static_cast<int>(points.size()) / 10) << "pose " << pose;
+  }
+  // A refit to a mesh with a non-finite vertex (a refit takes any floats): the triangles round it
+  // are crossed by no ray, so the mesh has a hole and rays along other directions may count
+  // otherwise; what is asked is an answer, finite and not negative, and (in the sanitizer build)
+  // no undefined behaviour on the way.
+  {
+    std::vector<Vec3> P = body.positions();
+    P[P.size() / 2] = Vec3::Constant(std::numeric_limits<float>::quiet_NaN());
+    ASSERT_TRUE(bvh.refit(P));
+    const std::vector<Vec3> points =
+        probePoints(body.positions(), body.indices(), test::repeatsUnderSanitizers(1000, 4), 97);
+    std::vector<float> batched(points.size(), -1.0f);
+    bvh.depthsInside(points.data(), points.size(), batched.data());
+    for (size_t i = 0; i < points.size(); ++i) ASSERT_TRUE(std::isfinite(batched[i]) && batched[i] >= 0.0f) << i;
+  }
+  // An empty tree and an empty batch answer 0 and write nothing, as depthInside does.
+  float depth = -1.0f;
+  const Vec3 q(0.0f, 1.0f, 0.0f);
+  TriangleBvh().depthsInside(&q, 1, &depth);
+  EXPECT_EQ(depth, 0.0f);
+  bvh.depthsInside(nullptr, 0, nullptr);
+}
+
 // Every particle ends at least `margin` outside the mesh, except where no such position is
 // reachable by projection: (a) the closest point lies on buried surface (the body mesh intersects
 // itself at the shoulder stitch and the crotch bridge; the projection target is then inside the

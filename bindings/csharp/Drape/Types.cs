@@ -778,7 +778,7 @@ namespace Drape
     }
 
     /// <summary>drape_garment_accuracy (40 bytes; 32 before the openings): how accurate the garment
-    /// is now (a diagnostic, about 1 ms per 1 000 particles).</summary>
+    /// is now (a diagnostic, about 0.6 ms per 1 000 particles).</summary>
     [StructLayout(LayoutKind.Sequential)]
     public struct GarmentAccuracy
     {

@@ -821,13 +821,17 @@ GarmentAccuracy GarmentSim::measure(const std::vector<Ellipsoid>& ellipsoids, co
     }
   }
   if (bvh != nullptr && !bvh->empty()) {
-    scratch.clear();
+    // Inside by the winding number, not the pseudo-normal sign: the body mesh intersects itself
+    // at the shoulder stitches and the crotch bridge, where that sign misreads points outside.
+    // All particles in one call (TriangleBvh::depthsInside: one grid of the body's triangles
+    // instead of a tree walk per particle, the same depths).
+    std::vector<Vec3> points(particleCount());
+    for (size_t i = 0; i < points.size(); ++i) points[i] = x[i].head<3>();
+    scratch.assign(points.size(), 0.0f);
+    bvh->depthsInside(points.data(), points.size(), scratch.data());
     size_t deep = 0;
-    for (size_t i = 0; i < particleCount(); ++i) {
-      // Inside by the winding number, not the pseudo-normal sign: the body mesh intersects itself
-      // at the shoulder stitches and the crotch bridge, where that sign misreads points outside.
-      const float depth = bvh->depthInside(x[i].head<3>()) * 1000.0f;
-      scratch.push_back(depth);
+    for (float& depth : scratch) {
+      depth *= 1000.0f;
       if (depth > 2.0f) ++deep;
     }
     if (!scratch.empty()) {

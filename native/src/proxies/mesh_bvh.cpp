@@ -21,6 +21,70 @@ Vec3 closestOnSegment(const Vec3& p, const Vec3& a, const Vec3& b, float& d2) {
   return q;
 }
 
+// What the ray o + t d, t > 0, does at triangle (a, b, c): misses it, crosses it leaving the solid
+// (+1: through an outward face) or entering (-1), or passes too close to an edge or a vertex, or
+// along the triangle's plane through it, to tell (the caller tries another direction).
+enum class RayHit : int { Entering = -1, Miss = 0, Leaving = 1, Ambiguous = 2 };
+
+// Moller-Trumbore in double precision. Barycentric coordinates within kEdgeTol of a triangle's
+// border make the ray ambiguous: it may cross the two triangles sharing that edge both or neither
+// in float data.
+inline RayHit rayTriangle(const Plain3<double>& oo, const Plain3<double>& dd, const Vec3& af, const Vec3& bf,
+                          const Vec3& cf) {
+  using D3 = Plain3<double>;
+  constexpr double kEdgeTol = 1e-7;
+  const D3 a = plain3<double>(af);
+  const D3 e1 = plain3<double>(bf) - a;
+  const D3 e2 = plain3<double>(cf) - a;
+  const D3 pv = cross(dd, e2);
+  const double det = dot(e1, pv);
+  const double scale = norm(e1) * norm(e2);
+  if (!(scale > 0.0)) return RayHit::Miss;  // degenerate: bounds no volume
+  if (std::fabs(det) < 1e-9 * scale) {
+    // Along the plane: ambiguous only if the ray runs through the triangle's plane near p.
+    return std::fabs(dot(oo - a, cross(e1, e2))) < 1e-9 * scale ? RayHit::Ambiguous : RayHit::Miss;
+  }
+  const D3 tv = oo - a;
+  const double u = dot(tv, pv) / det;
+  if (u < -kEdgeTol || u > 1.0 + kEdgeTol) return RayHit::Miss;
+  const D3 qv = cross(tv, e1);
+  const double v = dot(dd, qv) / det;
+  if (v < -kEdgeTol || u + v > 1.0 + kEdgeTol) return RayHit::Miss;
+  const double t = dot(e2, qv) / det;
+  if (t <= 0.0) return RayHit::Miss;  // behind p (p on the surface itself: its depth is ~0 either way)
+  if (u < kEdgeTol || v < kEdgeTol || u + v > 1.0 - kEdgeTol) return RayHit::Ambiguous;
+  // det = -d . (e1 x e2): negative where the ray leaves through the (outward) face.
+  return det < 0.0 ? RayHit::Leaving : RayHit::Entering;
+}
+
+// Three fixed ray directions in no symmetry plane of a body (none along an axis or a diagonal).
+const Eigen::Vector3d* rayDirections() {
+  static const Eigen::Vector3d kDirs[3] = {Eigen::Vector3d(0.2673, 0.5345, 0.8018).normalized(),
+                                           Eigen::Vector3d(-0.7071, 0.3015, -0.6396).normalized(),
+                                           Eigen::Vector3d(0.5774, -0.8165, 0.1543).normalized()};
+  return kDirs;
+}
+
+// The projected triangle with corners (u0, v0), (u1, v1), (u2, v2) as three edge lines a u + b v + c,
+// each the signed distance to its edge's line, positive inside (the triangle's orientation either
+// way): a point lies within m of the triangle's inside when all three are >= -m. A triangle with
+// no area gets lines that pass every point (the exact test decides).
+inline void edgeLines(const double* c, double* line) {
+  const double area2 = (c[2] - c[0]) * (c[5] - c[1]) - (c[3] - c[1]) * (c[4] - c[0]);
+  for (int e = 0; e < 3; ++e) {
+    const double au = c[2 * e], av = c[2 * e + 1];
+    const double eu = c[(2 * e + 2) % 6] - au, ev = c[(2 * e + 3) % 6] - av;
+    const double len = std::sqrt(eu * eu + ev * ev);
+    double* l = line + 3 * e;
+    if (area2 == 0.0 || !(len > 0.0)) {
+      l[0] = l[1] = 0.0, l[2] = 1.0;
+      continue;
+    }
+    const double k = (area2 > 0.0 ? 1.0 : -1.0) / len;
+    l[0] = -ev * k, l[1] = eu * k, l[2] = (ev * au - eu * av) * k;
+  }
+}
+
 inline float boxDistance2(const Vec3& p, const Vec3& lo, const Vec3& hi) {
   float d2 = 0.0f;
   for (int i = 0; i < 3; ++i) {
@@ -366,10 +430,6 @@ float TriangleBvh::signedDistance(const Vec3& p) const {
 }
 
 bool TriangleBvh::rayCrossings(const Vec3& p, const Eigen::Vector3d& d, int& crossings) const {
-  // Moller-Trumbore in double precision. Barycentric coordinates within kEdgeTol of a triangle's
-  // border make the ray ambiguous: it may cross the two triangles sharing that edge both or
-  // neither in float data, so the caller tries another direction.
-  constexpr double kEdgeTol = 1e-7;
   const Eigen::Vector3d o = p.cast<double>();
   const Eigen::Vector3d inv(1.0 / d.x(), 1.0 / d.y(), 1.0 / d.z());
   crossings = 0;
@@ -395,32 +455,11 @@ bool TriangleBvh::rayCrossings(const Vec3& p, const Eigen::Vector3d& d, int& cro
     }
     // The triangle tests in plain doubles (common/plain3.h): every triangle of every visited leaf,
     // for every vertex whose depth a measurement asks.
-    using D3 = Plain3<double>;
-    const D3 dd{d.x(), d.y(), d.z()}, oo{o.x(), o.y(), o.z()};
+    const Plain3<double> dd{d.x(), d.y(), d.z()}, oo{o.x(), o.y(), o.z()};
     for (uint32_t s = n.first; s < n.first + n.count; ++s) {
-      const D3 a = plain3<double>(corners_[3 * s]);
-      const D3 e1 = plain3<double>(corners_[3 * s + 1]) - a;
-      const D3 e2 = plain3<double>(corners_[3 * s + 2]) - a;
-      const D3 pv = cross(dd, e2);
-      const double det = dot(e1, pv);
-      const double scale = norm(e1) * norm(e2);
-      if (!(scale > 0.0)) continue;  // degenerate: bounds no volume
-      if (std::fabs(det) < 1e-9 * scale) {
-        // Along the plane: ambiguous only if the ray runs through the triangle's plane near p.
-        if (std::fabs(dot(oo - a, cross(e1, e2))) < 1e-9 * scale) return false;
-        continue;
-      }
-      const D3 tv = oo - a;
-      const double u = dot(tv, pv) / det;
-      if (u < -kEdgeTol || u > 1.0 + kEdgeTol) continue;
-      const D3 qv = cross(tv, e1);
-      const double v = dot(dd, qv) / det;
-      if (v < -kEdgeTol || u + v > 1.0 + kEdgeTol) continue;
-      const double t = dot(e2, qv) / det;
-      if (t <= 0.0) continue;  // behind p (p on the surface itself: its depth is ~0 either way)
-      if (u < kEdgeTol || v < kEdgeTol || u + v > 1.0 - kEdgeTol) return false;
-      // det = -d . (e1 x e2): negative where the ray leaves through the (outward) face.
-      crossings += det < 0.0 ? 1 : -1;
+      const RayHit h = rayTriangle(oo, dd, corners_[3 * s], corners_[3 * s + 1], corners_[3 * s + 2]);
+      if (h == RayHit::Ambiguous) return false;
+      crossings += static_cast<int>(h);
     }
   }
   return true;
@@ -428,10 +467,7 @@ bool TriangleBvh::rayCrossings(const Vec3& p, const Eigen::Vector3d& d, int& cro
 
 int TriangleBvh::winding(const Vec3& p) const {
   if (nodes_.empty() || !p.allFinite()) return 0;
-  // Three fixed directions in no symmetry plane of a body (none along an axis or a diagonal).
-  static const Eigen::Vector3d kDirs[3] = {Eigen::Vector3d(0.2673, 0.5345, 0.8018).normalized(),
-                                           Eigen::Vector3d(-0.7071, 0.3015, -0.6396).normalized(),
-                                           Eigen::Vector3d(0.5774, -0.8165, 0.1543).normalized()};
+  const Eigen::Vector3d* kDirs = rayDirections();
   // The count is the same along any ray that crosses no edge (the mesh is closed), but its cost is
   // the boxes the ray passes: the ray first tried is the one of the six (kDirs and their
   // opposites) that leaves the root box soonest (a quarter fewer boxes and a third fewer triangles
@@ -439,7 +475,8 @@ int TriangleBvh::winding(const Vec3& p) const {
   const Node& root = nodes_[0];
   Eigen::Vector3d first = kDirs[0];
   double first_exit = std::numeric_limits<double>::infinity();
-  for (const Eigen::Vector3d& dir : kDirs) {
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d& dir = kDirs[i];
     for (const double sign : {1.0, -1.0}) {
       const Eigen::Vector3d d = sign * dir;
       double exit = std::numeric_limits<double>::infinity();
@@ -452,8 +489,8 @@ int TriangleBvh::winding(const Vec3& p) const {
   }
   int crossings = 0;
   if (rayCrossings(p, first, crossings)) return crossings;
-  for (const Eigen::Vector3d& d : kDirs)
-    if (rayCrossings(p, d, crossings)) return crossings;
+  for (int i = 0; i < 3; ++i)
+    if (rayCrossings(p, kDirs[i], crossings)) return crossings;
   // Every ray grazed an edge: the solid-angle sum over every triangle (body/mesh_metrics.h).
   double omega = 0.0;
   for (size_t s = 0; s < tris_.size(); ++s)
@@ -464,6 +501,99 @@ int TriangleBvh::winding(const Vec3& p) const {
 float TriangleBvh::depthInside(const Vec3& p) const {
   if (nodes_.empty() || winding(p) < 1) return 0.0f;
   return closest(p).distance;
+}
+
+void TriangleBvh::depthsInside(const Vec3* points, size_t n, float* out) const {
+  if (n == 0) return;
+  std::fill(out, out + n, 0.0f);
+  if (nodes_.empty()) return;
+  // The plane across the ray direction d: orthonormal u, v (double), every triangle's corners
+  // projected onto it. A ray from p crosses a triangle, or passes it closely enough to be
+  // ambiguous, only where p's projection lies in the triangle's up to the crossing test's
+  // barycentric tolerance (far below kGrow), so the triangles whose projection lies within kGrow
+  // of p's are every triangle the test must see: a grid of cells lists those whose projected box
+  // (grown by kGrow) covers the cell, and each one's edge lines tell within kGrow exactly.
+  constexpr double kGrow = 1e-4;
+  const Eigen::Vector3d d = rayDirections()[0];
+  const Eigen::Vector3d helper = std::fabs(d.x()) < 0.6 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d u = d.cross(helper).normalized(), v = d.cross(u);
+  const size_t tri_count = tris_.size();
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  // Scratch kept per thread (a few hundred kilobytes for a body): a fresh allocation this size
+  // per call is mapped and zeroed anew, which cost as much as the rays saved.
+  thread_local std::vector<double> box, lines;
+  thread_local std::vector<uint32_t> start, next, slots;
+  box.resize(4 * tri_count);   // per slot: lo u, lo v, hi u, hi v
+  lines.resize(9 * tri_count);  // per slot: its projection's three edge lines (edgeLines)
+  double lo_u = kInf, lo_v = kInf, hi_u = -kInf, hi_v = -kInf;
+  for (size_t t = 0; t < tri_count; ++t) {
+    double b[4] = {kInf, kInf, -kInf, -kInf};
+    double flat[6];
+    for (size_t c = 0; c < 3; ++c) {
+      const Eigen::Vector3d q = corners_[3 * t + c].cast<double>();
+      const double pu = q.dot(u), pv = q.dot(v);
+      flat[2 * c] = pu, flat[2 * c + 1] = pv;
+      b[0] = std::min(b[0], pu), b[1] = std::min(b[1], pv), b[2] = std::max(b[2], pu), b[3] = std::max(b[3], pv);
+    }
+    edgeLines(flat, &lines[9 * t]);
+    double* out_box = &box[4 * t];
+    out_box[0] = b[0] - kGrow, out_box[1] = b[1] - kGrow, out_box[2] = b[2] + kGrow, out_box[3] = b[3] + kGrow;
+    lo_u = std::min(lo_u, out_box[0]), lo_v = std::min(lo_v, out_box[1]);
+    hi_u = std::max(hi_u, out_box[2]), hi_v = std::max(hi_v, out_box[3]);
+  }
+  // About one triangle per cell (a body's triangles are a few centimetres across), at most 1024
+  // cells along a side.
+  const double extent_u = std::max(hi_u - lo_u, 1e-6), extent_v = std::max(hi_v - lo_v, 1e-6);
+  const double cell = std::max(std::sqrt(extent_u * extent_v / static_cast<double>(tri_count)),
+                               std::max(extent_u, extent_v) / 1024.0);
+  const int nu = std::max(1, std::min(1024, static_cast<int>(std::ceil(extent_u / cell))));
+  const int nv = std::max(1, std::min(1024, static_cast<int>(std::ceil(extent_v / cell))));
+  auto cellU = [&](double x) { return std::min(nu - 1, std::max(0, static_cast<int>((x - lo_u) / cell))); };
+  auto cellV = [&](double y) { return std::min(nv - 1, std::max(0, static_cast<int>((y - lo_v) / cell))); };
+  // Each cell's triangles, compressed: start[c] .. start[c + 1] in `slots` (a counting sort).
+  const size_t cells = static_cast<size_t>(nu) * static_cast<size_t>(nv);
+  start.assign(cells + 1, 0);
+  auto forCells = [&](size_t t, auto&& f) {
+    const double* b = &box[4 * t];
+    if (!(b[0] <= b[2] && b[1] <= b[3])) return;  // a non-finite corner (a refit takes any floats): no crossing
+    const int u1 = cellU(b[2]), v1 = cellV(b[3]);
+    for (int cv = cellV(b[1]); cv <= v1; ++cv)
+      for (int cu = cellU(b[0]); cu <= u1; ++cu) f(static_cast<size_t>(cv) * static_cast<size_t>(nu) + static_cast<size_t>(cu));
+  };
+  for (size_t t = 0; t < tri_count; ++t) forCells(t, [&](size_t c) { ++start[c + 1]; });
+  for (size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
+  next.assign(start.begin(), start.end() - 1);
+  slots.resize(start.back());
+  for (size_t t = 0; t < tri_count; ++t) forCells(t, [&](size_t c) { slots[next[c]++] = static_cast<uint32_t>(t); });
+
+  const Plain3<double> dd{d.x(), d.y(), d.z()};
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3& p = points[i];
+    if (!p.allFinite()) continue;  // depthInside: 0
+    const Eigen::Vector3d o = p.cast<double>();
+    const double pu = o.dot(u), pv = o.dot(v);
+    int crossings = 0;
+    bool ambiguous = false;
+    if (pu >= lo_u && pu <= hi_u && pv >= lo_v && pv <= hi_v) {  // else no triangle to cross
+      const size_t c = static_cast<size_t>(cellV(pv)) * static_cast<size_t>(nu) + static_cast<size_t>(cellU(pu));
+      const Plain3<double> oo{o.x(), o.y(), o.z()};
+      for (uint32_t k = start[c]; k < start[c + 1] && !ambiguous; ++k) {
+        const uint32_t t = slots[k];
+        const double* l = &lines[9 * t];
+        const double inside = std::min(std::min(l[0] * pu + l[1] * pv + l[2], l[3] * pu + l[4] * pv + l[5]),
+                                       l[6] * pu + l[7] * pv + l[8]);
+        if (inside < -kGrow) continue;  // farther than kGrow outside its projection
+        const RayHit h = rayTriangle(oo, dd, corners_[3 * t], corners_[3 * t + 1], corners_[3 * t + 2]);
+        if (h == RayHit::Ambiguous) ambiguous = true;
+        else crossings += static_cast<int>(h);
+      }
+    }
+    if (ambiguous) {
+      out[i] = depthInside(p);  // the one-point way: other directions, then the solid angles
+    } else if (crossings >= 1) {
+      out[i] = closest(p).distance;
+    }
+  }
 }
 
 }  // namespace drape

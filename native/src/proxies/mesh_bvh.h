@@ -10,8 +10,8 @@
 // always enough and no query recurses. Nodes are stored depth first (a node's children come after
 // it), so refit is one backward sweep. Triangle corners are copied in leaf order for locality.
 //
-// Queries are const and keep no state, so several threads may query one tree at once (not while
-// it is being built or refitted).
+// Queries are const and keep no state (depthsInside's scratch is the calling thread's), so several
+// threads may query one tree at once (not while it is being built or refitted).
 //
 // Refit: the body's topology is fixed and only its vertices move, so every frame after the first
 // rewrites the corner copies, face / edge / vertex pseudo-normals and node boxes in place without
@@ -110,6 +110,18 @@ class TriangleBvh {
   // point is on such a sheet is, with its distance to that sheet (a lower bound of the depth to
   // the outer surface). 0 for an empty tree or a non-finite p.
   float depthInside(const Vec3& p) const;
+  // depthInside of n points at once, out[i] for points[i]: on a closed mesh (the body's) the same
+  // answers, to the float, in about two thirds of the time for a garment's worth of points (on a
+  // mesh with holes, e.g. refitted to a non-finite vertex, rays along other directions may count
+  // otherwise: an answer, finite and >= 0, not necessarily depthInside's). Every ray goes along one fixed
+  // direction; instead of the tree, a grid over the plane across that direction, built once per
+  // call, lists the triangles whose projection's box covers each cell, and a triangle is passed to
+  // the same double-precision crossing test only when the ray's point lies within 0.1 mm of its
+  // projection (a ray crosses it, or grazes it closely enough to be ambiguous, only inside that).
+  // A point whose ray is ambiguous goes the one-point way (other directions, the solid angles).
+  // The grid lives in scratch memory of the calling thread, kept between calls: several threads
+  // may still query one tree at once.
+  void depthsInside(const Vec3* points, size_t n, float* out) const;
   // Sign of a hit as described above: +1 outside (or on the surface), -1 inside.
   static float hitSign(const Vec3& p, const Hit& h) {
     return (p - h.point).dot(h.pseudo_normal) < 0.0f ? -1.0f : 1.0f;
