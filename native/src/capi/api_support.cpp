@@ -80,6 +80,18 @@ drape_result checkStructSize(uint32_t struct_size, size_t min_size, const char* 
   return DRAPE_OK;
 }
 
+drape_result checkSizedInit(const char* fn, const void* object, const char* what, uint32_t struct_size,
+                            size_t first_size, size_t current_size) {
+  if (!object) return fail(DRAPE_ERROR_NULL_ARGUMENT, std::string(fn) + ": " + what + " is NULL");
+  if (struct_size < first_size || struct_size > current_size) {
+    return fail(DRAPE_ERROR_INVALID_ARGUMENT,
+                std::string(fn) + ": struct_size is " + std::to_string(struct_size) + ", expected " +
+                    std::to_string(first_size) + " to " + std::to_string(current_size) +
+                    " (a larger one comes from a header newer than this library)");
+  }
+  return DRAPE_OK;
+}
+
 const char* lastError() { return t_lastError.c_str(); }
 
 }  // namespace drape::api

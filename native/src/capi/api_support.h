@@ -40,10 +40,16 @@ void setCurrentFunction(const char* function);
   if (!var)                                                                                      \
   return ::drape::api::fail(DRAPE_ERROR_INVALID_HANDLE, fn ": context is not a live drape_context (destroyed or never created)")
 
-// Validates the struct_size field of a caller struct: at least the first released size.
 const char* lastError();
 
+// Validates the struct_size field of a caller struct: at least the first released size.
 drape_result checkStructSize(uint32_t struct_size, size_t min_size, const char* what);
+
+// Validates the arguments of a sized init (drape_*_init_sized): `object` (named `what` in the
+// message) not NULL, struct_size from the struct's first layout to this library's sizeof (a larger
+// one comes from a header newer than the library). Nothing is written when it fails.
+drape_result checkSizedInit(const char* fn, const void* object, const char* what, uint32_t struct_size,
+                            size_t first_size, size_t current_size);
 
 inline bool finite(float v) { return std::isfinite(v); }
 inline bool finite(double v) { return std::isfinite(v); }

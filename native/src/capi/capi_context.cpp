@@ -35,14 +35,9 @@ drape_result toShapeInput(const drape_body_shape& s, drape::BodyShapeInput& in) 
 extern "C" {
 
 DRAPE_API drape_result DRAPE_CALL drape_context_desc_init_sized(drape_context_desc* desc, uint32_t struct_size) {
-  static const char* fn = "drape_context_desc_init_sized";
-  if (!desc) return fail(DRAPE_ERROR_NULL_ARGUMENT, std::string(fn) + ": desc is NULL");
-  if (struct_size < DRAPE_CONTEXT_DESC_SIZE_V1 || struct_size > sizeof(drape_context_desc)) {
-    return fail(DRAPE_ERROR_INVALID_ARGUMENT,
-                std::string(fn) + ": struct_size is " + std::to_string(struct_size) + ", expected " +
-                    std::to_string(DRAPE_CONTEXT_DESC_SIZE_V1) + " to " + std::to_string(sizeof(drape_context_desc)) +
-                    " (a larger one comes from a header newer than this library)");
-  }
+  if (drape_result r = checkSizedInit("drape_context_desc_init_sized", desc, "desc", struct_size,
+                                      DRAPE_CONTEXT_DESC_SIZE_V1, sizeof(drape_context_desc)))
+    return r;
   drape_context_desc d;
   std::memset(&d, 0, sizeof(d));
   const drape::TrackerParams t;

@@ -308,14 +308,9 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_template_init(drape_garment_temp
 }
 
 DRAPE_API drape_result DRAPE_CALL drape_cloth_params_init_sized(drape_cloth_params* params, uint32_t struct_size) {
-  static const char* fn = "drape_cloth_params_init_sized";
-  if (!params) return fail(DRAPE_ERROR_NULL_ARGUMENT, std::string(fn) + ": params is NULL");
-  if (struct_size < DRAPE_CLOTH_PARAMS_SIZE_V1 || struct_size > sizeof(drape_cloth_params)) {
-    return fail(DRAPE_ERROR_INVALID_ARGUMENT,
-                std::string(fn) + ": struct_size is " + std::to_string(struct_size) + ", expected " +
-                    std::to_string(DRAPE_CLOTH_PARAMS_SIZE_V1) + " to " + std::to_string(sizeof(drape_cloth_params)) +
-                    " (a larger one comes from a header newer than this library)");
-  }
+  if (drape_result r = checkSizedInit("drape_cloth_params_init_sized", params, "params", struct_size,
+                                      DRAPE_CLOTH_PARAMS_SIZE_V1, sizeof(drape_cloth_params)))
+    return r;
   drape_cloth_params c;
   c.struct_size = struct_size;
   fromSimParams(drape::GarmentSimParams{}, c);

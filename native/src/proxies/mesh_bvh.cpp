@@ -58,8 +58,9 @@ inline RayHit rayTriangle(const Plain3<double>& oo, const Plain3<double>& dd, co
 }
 
 // Three fixed ray directions in no symmetry plane of a body (none along an axis or a diagonal).
-const Eigen::Vector3d* rayDirections() {
-  static const Eigen::Vector3d kDirs[3] = {Eigen::Vector3d(0.2673, 0.5345, 0.8018).normalized(),
+using RayDirections = Eigen::Vector3d[3];
+const RayDirections& rayDirections() {
+  static const RayDirections kDirs = {Eigen::Vector3d(0.2673, 0.5345, 0.8018).normalized(),
                                            Eigen::Vector3d(-0.7071, 0.3015, -0.6396).normalized(),
                                            Eigen::Vector3d(0.5774, -0.8165, 0.1543).normalized()};
   return kDirs;
@@ -467,7 +468,7 @@ bool TriangleBvh::rayCrossings(const Vec3& p, const Eigen::Vector3d& d, int& cro
 
 int TriangleBvh::winding(const Vec3& p) const {
   if (nodes_.empty() || !p.allFinite()) return 0;
-  const Eigen::Vector3d* kDirs = rayDirections();
+  const RayDirections& kDirs = rayDirections();
   // The count is the same along any ray that crosses no edge (the mesh is closed), but its cost is
   // the boxes the ray passes: the ray first tried is the one of the six (kDirs and their
   // opposites) that leaves the root box soonest (a quarter fewer boxes and a third fewer triangles
@@ -475,8 +476,7 @@ int TriangleBvh::winding(const Vec3& p) const {
   const Node& root = nodes_[0];
   Eigen::Vector3d first = kDirs[0];
   double first_exit = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < 3; ++i) {
-    const Eigen::Vector3d& dir = kDirs[i];
+  for (const Eigen::Vector3d& dir : kDirs) {
     for (const double sign : {1.0, -1.0}) {
       const Eigen::Vector3d d = sign * dir;
       double exit = std::numeric_limits<double>::infinity();
@@ -489,8 +489,8 @@ int TriangleBvh::winding(const Vec3& p) const {
   }
   int crossings = 0;
   if (rayCrossings(p, first, crossings)) return crossings;
-  for (int i = 0; i < 3; ++i)
-    if (rayCrossings(p, kDirs[i], crossings)) return crossings;
+  for (const Eigen::Vector3d& d : kDirs)
+    if (rayCrossings(p, d, crossings)) return crossings;
   // Every ray grazed an edge: the solid-angle sum over every triangle (body/mesh_metrics.h).
   double omega = 0.0;
   for (size_t s = 0; s < tris_.size(); ++s)
@@ -536,10 +536,10 @@ void TriangleBvh::depthsInside(const Vec3* points, size_t n, float* out) const {
       b[0] = std::min(b[0], pu), b[1] = std::min(b[1], pv), b[2] = std::max(b[2], pu), b[3] = std::max(b[3], pv);
     }
     edgeLines(flat, &lines[9 * t]);
-    double* out_box = &box[4 * t];
-    out_box[0] = b[0] - kGrow, out_box[1] = b[1] - kGrow, out_box[2] = b[2] + kGrow, out_box[3] = b[3] + kGrow;
-    lo_u = std::min(lo_u, out_box[0]), lo_v = std::min(lo_v, out_box[1]);
-    hi_u = std::max(hi_u, out_box[2]), hi_v = std::max(hi_v, out_box[3]);
+    double* grown = &box[4 * t];
+    grown[0] = b[0] - kGrow, grown[1] = b[1] - kGrow, grown[2] = b[2] + kGrow, grown[3] = b[3] + kGrow;
+    lo_u = std::min(lo_u, grown[0]), lo_v = std::min(lo_v, grown[1]);
+    hi_u = std::max(hi_u, grown[2]), hi_v = std::max(hi_v, grown[3]);
   }
   // About one triangle per cell (a body's triangles are a few centimetres across), at most 1024
   // cells along a side.
