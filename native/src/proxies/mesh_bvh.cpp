@@ -520,7 +520,7 @@ void TriangleBvh::depthsInside(const Vec3* points, size_t n, float* out) const {
   const size_t tri_count = tris_.size();
   constexpr double kInf = std::numeric_limits<double>::infinity();
   // Scratch kept per thread (a few hundred kilobytes for a body): a fresh allocation this size
-  // per call is mapped and zeroed anew, which cost as much as the rays saved.
+  // per call is zeroed anew, which cost as much as the rays saved.
   thread_local std::vector<double> box, lines;
   thread_local std::vector<uint32_t> start, next, slots;
   box.resize(4 * tri_count);   // per slot: lo u, lo v, hi u, hi v
