@@ -423,6 +423,22 @@ struct Machine {
 
   void setParams() {
     drape_garment* g = pickGarment();
+    // Now and then a layer as well (drape_garment_set_layer): in range it comes back, outside it
+    // is refused and changes nothing.
+    const uint8_t lm = in.u8();
+    if (lm & 1) {
+      const int32_t layer = 3 * static_cast<int32_t>(static_cast<int8_t>(in.u8()));  // -384 .. 381
+      int32_t before = -1000, after = -1000;
+      const bool live = DRAPE_FUZZ_CALL(drape_garment_get_layer(g, &before)) == DRAPE_OK;
+      const drape_result r = DRAPE_FUZZ_CALL(drape_garment_set_layer(g, layer));
+      if (live) {
+        DRAPE_FUZZ_CHECK(r == (layer >= 0 && layer <= 255 ? DRAPE_OK : DRAPE_ERROR_OUT_OF_RANGE), "set_layer's range");
+        DRAPE_FUZZ_CHECK(DRAPE_FUZZ_CALL(drape_garment_get_layer(g, &after)) == DRAPE_OK, "get_layer after set");
+        DRAPE_FUZZ_CHECK(after == (r == DRAPE_OK ? layer : before), "a layer comes back as set; a refused one changes nothing");
+      } else {
+        DRAPE_FUZZ_CHECK(r != DRAPE_OK, "set_layer on a dead garment");
+      }
+    }
     drape_cloth_params c;
     clothParams(c);
     drape_cloth_params before;

@@ -201,6 +201,42 @@ namespace Drape.Tests
             Assert.NotEqual(positions, later);
         }
 
+        /// <summary>Layers: 0 by default, round trip, range; a T-shirt worn over trousers moves out
+        /// where the trousers are, and the trousers under it are the trousers alone to the bit.</summary>
+        [Fact]
+        public void Layer_RoundTripsAndAShirtOverTrousersLiesOnThem()
+        {
+            Vector3f[] Run(bool layered, out Vector3f[] trousersEnd)
+            {
+                using var ctx = new Context();
+                using Garment trousers = ctx.AddGarment(Small(GarmentKind.Trousers));
+                using Garment shirt = ctx.AddGarment(Small(GarmentKind.TShirt));
+                Assert.Equal(0, shirt.Layer);
+                if (layered)
+                {
+                    trousers.Layer = 1;
+                    shirt.Layer = 2;
+                    Assert.Equal(2, shirt.Layer);
+                    var e = Assert.Throws<DrapeException>(() => shirt.Layer = 256);
+                    Assert.Equal(ResultCode.OutOfRange, e.Code);
+                    Assert.Contains("drape_garment_set_layer", e.NativeMessage);
+                    Assert.Throws<DrapeException>(() => shirt.Layer = -1);
+                    Assert.Equal(2, shirt.Layer);
+                }
+                StepFrames(ctx, 30);
+                trousersEnd = new Vector3f[trousers.VertexCount];
+                trousers.ReadPositions(trousersEnd);
+                var end = new Vector3f[shirt.VertexCount];
+                shirt.ReadPositions(end);
+                return end;
+            }
+            Vector3f[] flat = Run(false, out Vector3f[] trousersFlat);
+            Vector3f[] over = Run(true, out Vector3f[] trousersUnder);
+            Assert.Equal(trousersFlat, trousersUnder);
+            Assert.NotEqual(flat, over);
+            foreach (Vector3f p in over) Assert.True(float.IsFinite(p.X) && float.IsFinite(p.Y) && float.IsFinite(p.Z));
+        }
+
         [Fact]
         public void SetBodyShape_RefitsTheWornGarment_SameVerticesLongerCut()
         {

@@ -113,6 +113,24 @@ namespace Drape
             DrapeException.Check(Native.drape_garment_set_params(h, &p));
         }
 
+        /// <summary>The garment's layer (drape_garment_set_layer / drape_garment_get_layer): a garment
+        /// of layer L &gt;= 2 is worn over every garment of its context whose layer is 1 .. L - 1 (a
+        /// T-shirt over trousers: trousers 1, T-shirt 2) and lies on their cloth instead of passing
+        /// through it; 0, the default, is not layered. In [0, 255]: outside it throws
+        /// <see cref="DrapeException"/> (<see cref="ResultCode.OutOfRange"/>) and nothing changes.
+        /// docs/garments.md, "Layered garments".</summary>
+        public int Layer
+        {
+            get
+            {
+                IntPtr h = Live;
+                int layer;
+                DrapeException.Check(Native.drape_garment_get_layer(h, &layer));
+                return layer;
+            }
+            set => DrapeException.Check(Native.drape_garment_set_layer(Live, value));
+        }
+
         // ---- Mesh --------------------------------------------------------------------------------
 
         /// <summary>

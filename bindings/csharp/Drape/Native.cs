@@ -188,6 +188,12 @@ namespace Drape
         internal static extern ResultCode drape_garment_get_params(IntPtr garment, ClothParams* outParams);
 
         [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_garment_set_layer(IntPtr garment, int layer);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
+        internal static extern ResultCode drape_garment_get_layer(IntPtr garment, int* outLayer);
+
+        [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]
         internal static extern ResultCode drape_context_step(IntPtr context, float dt);
 
         [DllImport(LibraryName, CallingConvention = Cdecl, ExactSpelling = true)]

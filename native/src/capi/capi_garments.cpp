@@ -502,6 +502,26 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_get_params(drape_garment* handle
   });
 }
 
+DRAPE_API drape_result DRAPE_CALL drape_garment_set_layer(drape_garment* handle, int32_t layer) {
+  return guarded("drape_garment_set_layer", [&]() -> drape_result {
+    DRAPE_CHECK_GARMENT("drape_garment_set_layer", handle);
+    if (layer < 0 || layer > Context::kMaxGarmentLayer)
+      return fail(DRAPE_ERROR_OUT_OF_RANGE, "drape_garment_set_layer: layer " + std::to_string(layer) +
+                                                " is outside [0, " + std::to_string(Context::kMaxGarmentLayer) + "]");
+    static_cast<Context*>(garment->api_owner)->setGarmentLayer(garment, layer);
+    return DRAPE_OK;
+  });
+}
+
+DRAPE_API drape_result DRAPE_CALL drape_garment_get_layer(drape_garment* handle, int32_t* out_layer) {
+  return guarded("drape_garment_get_layer", [&]() -> drape_result {
+    DRAPE_CHECK_GARMENT("drape_garment_get_layer", handle);
+    if (!out_layer) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_garment_get_layer: out_layer is NULL");
+    *out_layer = static_cast<Context*>(garment->api_owner)->garmentLayer(garment);
+    return DRAPE_OK;
+  });
+}
+
 DRAPE_API drape_result DRAPE_CALL drape_context_step(drape_context* context, float dt) {
   return guarded("drape_context_step", [&]() -> drape_result {
     DRAPE_CHECK_CONTEXT("drape_context_step", context);

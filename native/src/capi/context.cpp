@@ -525,9 +525,11 @@ GarmentSim* Context::adoptGarment(std::unique_ptr<GarmentSim> garment, RestCut c
   ReachParams rp;
   rp.margin_m = options_.reach_margin_m;
   std::vector<ReachSphere> reach = garmentReach(*garment, rp);
-  garmentCuts_.reserve(garments_.size() + 1);  // first: the two lists stay the same length
+  garmentCuts_.reserve(garments_.size() + 1);  // first: the three lists stay the same length
+  garmentLayers_.reserve(garments_.size() + 1);
   garments_.push_back(std::move(garment));
   garmentCuts_.push_back(GarmentCut{cut, shape_while_it_fits});
+  garmentLayers_.emplace_back();
   adaptive_.addGarment(garments_.back().get(), std::move(reach));
   reachDirty_ = true;
   applyBackend(*garments_.back());
@@ -543,11 +545,73 @@ bool Context::removeGarment(const GarmentSim* garment) {
       adaptive_.removeGarment(garment);
       reachDirty_ = true;
       garmentCuts_.erase(garmentCuts_.begin() + (it - garments_.begin()));
+      garmentLayers_.erase(garmentLayers_.begin() + (it - garments_.begin()));
       garments_.erase(it);
       return true;
     }
   }
   return false;
+}
+
+bool Context::setGarmentLayer(const GarmentSim* garment, int32_t layer) {
+  for (size_t i = 0; i < garments_.size(); ++i) {
+    if (garments_[i].get() != garment) continue;
+    if (garmentLayers_[i].layer == layer) return true;
+    garmentLayers_[i].layer = layer;
+    // What lies under which garment changed: every garment of the context steps again.
+    for (const auto& g : garments_) wakeGarment(g.get());
+    return true;
+  }
+  return false;
+}
+
+int32_t Context::garmentLayer(const GarmentSim* garment) const {
+  for (size_t i = 0; i < garments_.size(); ++i)
+    if (garments_[i].get() == garment) return garmentLayers_[i].layer;
+  return 0;
+}
+
+const std::vector<float>* Context::garmentLayerOffsets(const GarmentSim* garment) const {
+  for (size_t i = 0; i < garments_.size(); ++i)
+    if (garments_[i].get() == garment) return &garmentLayers_[i].over.offsets();
+  return nullptr;
+}
+
+void Context::measureLayers(size_t count) {
+  // A garment's cloth is measured when another lies over it. A garment not yet stepped lies on its
+  // rest pose, not on this body: it counts from its first step.
+  const auto under = [&](size_t j, int32_t over) {
+    const int32_t l = garmentLayers_[j].layer;
+    return l >= 1 && l < over && garments_[j]->steps() > 0;
+  };
+  for (size_t j = 0; j < garments_.size(); ++j) {
+    bool covered = false;
+    for (size_t i = 0; i < garments_.size() && !covered; ++i) covered = i != j && under(j, garmentLayers_[i].layer);
+    if (covered)
+      garmentLayers_[j].shell.measure(garments_[j]->positions(), garments_[j]->particleCount(), stepEllipsoids_);
+    else
+      garmentLayers_[j].shell.forgetHosts();
+  }
+  for (size_t i = 0; i < garments_.size(); ++i) {
+    GarmentLayer& me = garmentLayers_[i];
+    if (me.layer < 2) {  // nothing can be under it
+      me.over.reset();
+      continue;
+    }
+    me.over.beginStep(count);
+    for (size_t j = 0; j < garments_.size(); ++j)
+      if (j != i && under(j, me.layer)) me.over.addUnder(garmentLayers_[j].shell.offsets());
+    me.over.endMeasure();
+  }
+}
+
+bool Context::layerOver(size_t i, const std::vector<Ellipsoid>& start, const std::vector<Ellipsoid>& end) {
+  GarmentLayer& me = garmentLayers_[i];
+  if (!me.over.any()) return false;
+  // The step moves from the last step's offsets to this one's, as it moves the body.
+  LayerOffsets::grow(start, me.over.startOffsets(), me.start);
+  LayerOffsets::grow(end, me.over.offsets(), me.end);
+  return true;
 }
 
 drape_result Context::step(float dt, std::string& err) {
@@ -604,6 +668,7 @@ drape_result Context::beginStep(float dt, std::string& err) {
   const bool left_leg = trusted(Joint::HipL, Joint::KneeL), right_leg = trusted(Joint::HipR, Joint::KneeR);
   placement_[kCutShape].aim(this, kCutShape);
   placement_[kCutSkeleton].aim(this, kCutSkeleton);
+  measureLayers(now.size());
   for (size_t i = 0; i < garments_.size(); ++i) {
     const std::unique_ptr<GarmentSim>& g = garments_[i];
     g->setPlacementPath(&placement_[garmentCuts_[i].cut]);
@@ -616,8 +681,12 @@ drape_result Context::beginStep(float dt, std::string& err) {
     g->setTrackingNoise(tracker_.noiseSigmaM());  // noise bursts: garment_recovery.cpp
     g->setLegsTrusted(left_leg, right_leg);
     g->setPoseJumped(poseJumpPending_);
+    // A garment worn over others steps with the ellipsoids grown by the cloth under it.
+    const std::vector<Ellipsoid>& start = woke ? *woke : stepEllipsoids_;
+    const bool layered = layerOver(i, start, now);
     // Device frames are only staged here: the caller runs them all together (runStagedFrames).
-    g->stepBegin(*body_, woke ? *woke : stepEllipsoids_, now, dt, teleportPending_, true);
+    g->stepBegin(*body_, layered ? garmentLayers_[i].start : start, layered ? garmentLayers_[i].end : now, dt,
+                 teleportPending_, true);
     stepping_.push_back(g.get());
   }
   stepDt_ = dt;

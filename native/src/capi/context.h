@@ -5,6 +5,7 @@
 #include "body/body_model.h"
 #include "capi/adaptive.h"
 #include "body/body_shape.h"
+#include "cloth/garment_layers.h"
 #include "cloth/garment_sim.h"
 #include "proxies/fidelity.h"
 #include "proxies/mesh_bvh.h"
@@ -94,6 +95,15 @@ class Context {
   GarmentSim* adoptGarment(std::unique_ptr<GarmentSim> garment) { return adoptGarment(std::move(garment), contextCut()); }
   // Destroys it; false when it is not this context's.
   bool removeGarment(const GarmentSim* garment);
+  // Layered garments (drape_garment_set_layer): a garment of layer L >= 2 is worn over this
+  // context's garments of layers 1 .. L - 1; 0 (the default) is not layered. False when the
+  // garment is not this context's; the layer is checked by the caller (0 .. kMaxGarmentLayer).
+  static constexpr int32_t kMaxGarmentLayer = 255;
+  bool setGarmentLayer(const GarmentSim* garment, int32_t layer);
+  int32_t garmentLayer(const GarmentSim* garment) const;
+  // How far the cloth under a layered garment stood off each ellipsoid in its last step (m; empty
+  // when nothing was under it). For tests and diagnostics.
+  const std::vector<float>* garmentLayerOffsets(const GarmentSim* garment) const;
   size_t garmentCount() const { return garments_.size(); }
   GarmentSim& garment(size_t i) { return *garments_[i]; }
   // Runs update() if a frame is queued, then advances every garment by dt (seconds, (0, 10]).
@@ -201,6 +211,23 @@ class Context {
   };
   std::vector<GarmentCut> garmentCuts_;
   GarmentCut* cutEntry(const GarmentSim* garment);
+  // garments_[i]'s layer (drape_garment_set_layer; 0 = not layered) and, for a garment worn over
+  // others, how far their cloth stands off each ellipsoid and the ellipsoids grown by that, which
+  // its step reads until endStep (cloth/garment_layers.h). Parallel to garments_, as garmentCuts_.
+  struct GarmentLayer {
+    int32_t layer = 0;
+    ClothShell shell;     // its own cloth, measured while a garment lies over it
+    LayerOffsets over;    // what it steps with, over the shells under it
+    std::vector<Ellipsoid> start, end;
+  };
+  std::vector<GarmentLayer> garmentLayers_;
+  // Measures, for every layered garment, how far the cloth under it stands off each of the
+  // `count` ellipsoids (before any garment steps: every garment is where its last step left it,
+  // on stepEllipsoids_).
+  void measureLayers(size_t count);
+  // The ellipsoids garments_[i] steps with: the body's, or (a garment over others) grown by
+  // the cloth under it (false: the body's; true: garmentLayers_[i].start / end).
+  bool layerOver(size_t i, const std::vector<Ellipsoid>& start, const std::vector<Ellipsoid>& end);
   std::vector<Ellipsoid> stepEllipsoids_;  // the ellipsoids at the end of the last step
   // The way from each cut's rest pose into the pose now, for the garments placed this step
   // (cloth/placement_path.h; built only when one asks: capi/context_placement.cpp).
