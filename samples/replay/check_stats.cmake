@@ -2,7 +2,7 @@
 # replay_garment_obj, replay_bvh).
 #   cmake -DEXE=... -DOUT_DIR=... -DARGS="a|b|c" -DEXPECT_FRAMES=N -DEXPECT_OBJ=N
 #         [-DEXPECT_GARMENT=template|obj|none -DEXPECT_GARMENT_OBJ=N -DEXPECT_MEASURED=N]
-#         [-DEXPECT_SUBSTEP_HZ=N (garment.substep_hz)]
+#         [-DEXPECT_SUBSTEP_HZ=N (garment.substep_hz)] [-DEXPECT_UNDER=kind (--under; garment.under)]
 #         [-DEXPECT_FORMAT=kinect_csv] [-DEXPECT_BACKEND=cpu|opencl] [-DVOLUME_MIN_L=x -DVOLUME_MAX_L=y] [-DPYTHON=python3]
 #         [-DEXPECT_RENDERED=N -DEXPECT_PNG_SIZE=WxH -DEXPECT_SHEET=ON|OFF -DEXPECT_GIF=ON|OFF]
 #         -P check_stats.cmake
@@ -83,7 +83,7 @@ foreach(path "drape_version" "recording" "format" "layout" "frames" "rejected_fr
              "garment|body_surface_stretch|tubes|over_5pct" "garment|proxy_inside" "garment|body_penetration_mm|p99"
              "garment|body_penetration_mm|max" "garment|deeper_than_2mm" "garment|openings|tracked"
              "garment|openings|off_frames" "garment|openings|off_max" "garment|frames_measured"
-             "garment|teleport_resets" "garment|nan_resets" "garment|contacts" "garment|substeps"
+             "garment|teleport_resets" "garment|nan_resets" "garment|contacts" "garment|substeps" "garment|under"
              "render|frames_rendered" "render|every" "render|camera" "render|width" "render|height"
              "render|contact_sheet" "render|gif" "render|mp4" "render|ms_per_frame_median")
   string(REPLACE "|" ";" _keys "${path}")
@@ -256,6 +256,33 @@ else()
   if(NOT _edges GREATER 0)
     string(APPEND _failures "  garment.edges = ${_edges}, expected > 0\n")
   endif()
+endif()
+
+# --under (EXPECT_UNDER=<kind>): the garment under it, its OBJs (EXPECT_GARMENT_OBJ of them) and the
+# crossing measured on every measured frame; without it garment.under is null.
+if(DEFINED EXPECT_UNDER)
+  json_get(_ukind garment under kind)
+  if(NOT _ukind STREQUAL EXPECT_UNDER)
+    string(APPEND _failures "  garment.under.kind = ${_ukind}, expected ${EXPECT_UNDER}\n")
+  endif()
+  json_get(_uparticles garment under particles)
+  json_get(_uframes garment under crossing frames)
+  json_get(_uover garment under crossing over)
+  json_get(_gmeasured2 garment frames_measured)
+  expect_type(NUMBER garment under crossing under_share)
+  json_get(_ushare garment under crossing under_share)
+  if(NOT _uparticles GREATER 0 OR NOT _uover GREATER 0 OR _ushare LESS 0 OR _ushare GREATER 1)
+    string(APPEND _failures "  garment.under: ${_uparticles} particles, crossing over ${_uover}, share ${_ushare}; "
+                            "expected particles > 0, over > 0, 0 <= share <= 1\n")
+  endif()
+  expect_equal("garment.under.crossing.frames" "${_uframes}" "${_gmeasured2}")
+  if(DEFINED EXPECT_GARMENT_OBJ)
+    file(GLOB _uobjs "${OUT_DIR}/under_*.obj")
+    list(LENGTH _uobjs _uobj_count)
+    expect_equal("under OBJ files" "${_uobj_count}" "${EXPECT_GARMENT_OBJ}")
+  endif()
+else()
+  expect_type(NULL garment under)
 endif()
 
 if(DEFINED EXPECT_GARMENT_OBJ)

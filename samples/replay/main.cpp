@@ -211,6 +211,29 @@ int run(int argc, char** argv) {
     }
   }
 
+  // --under: a template worn under the garment (layers 1 and 2), with the same particles and cloth.
+  drape_garment* under = nullptr;
+  if (garment != nullptr && opt.under_kind >= 0) {
+    drape_garment_desc udesc;
+    drape_garment_desc_init(&udesc);
+    drape_garment_template utmpl;
+    drape_garment_template_init(&utmpl);
+    utmpl.kind = opt.under_kind;
+    if (opt.particles != 0) utmpl.particles = opt.particles;
+    udesc.solver = opt.solver;
+    udesc.cut = opt.garment_cut;
+    if (drape_result r = drape_context_add_garment_template(ctx.get(), &udesc, &utmpl, &cloth, &under)) {
+      if (isFatalLibraryError(r))
+        return fail(kExitFailure, "drape_context_add_garment_template (--under) failed: " + libraryReason(r));
+      return fail(kExitUsage, std::string("the ") + replay::garmentKindName(opt.under_kind) +
+                                  " garment (--under) was refused (" + libraryReason(r) + ")");
+    }
+    if (drape_result r = drape_garment_set_layer(under, 1))
+      return fail(kExitFailure, "drape_garment_set_layer failed: " + libraryReason(r));
+    if (drape_result r = drape_garment_set_layer(garment, 2))
+      return fail(kExitFailure, "drape_garment_set_layer failed: " + libraryReason(r));
+  }
+
   ReplayStats st;
   st.drape_version = drape_version_string();
   st.recording = path;
@@ -339,15 +362,41 @@ int run(int argc, char** argv) {
   st.volume_l.reserve(frames);
   constexpr uint32_t kMaxRejectionMessages = 5;
 
+  // --under: its mesh (indices once; positions and normals per frame) and the ellipsoids its
+  // crossing is measured against.
+  uint32_t under_vertices = 0, under_index_count = 0;
+  std::vector<drape_vec3> under_positions, under_normals;
+  std::vector<uint32_t> under_indices;
+  std::vector<drape_ellipsoid> ellipsoids;
+  uint32_t ellipsoid_capacity = 0;
+  if (under) {
+    if (drape_result r = drape_garment_get_mesh_size(under, &under_vertices, &under_index_count))
+      return fail(kExitFailure, "drape_garment_get_mesh_size (--under) failed: " + libraryReason(r));
+    under_positions.resize(under_vertices);
+    if (opt.write_obj || render_due) under_normals.resize(under_vertices);
+    under_indices.resize(under_index_count);
+    if (drape_result r = drape_garment_read_mesh(under, nullptr, nullptr, 0, under_indices.data(), under_index_count))
+      return fail(kExitFailure, "drape_garment_read_mesh (--under indices) failed: " + libraryReason(r));
+    uint32_t ne = 0;
+    if (drape_result r = drape_context_get_ellipsoid_count(ctx.get(), &ne))
+      return fail(kExitFailure, "drape_context_get_ellipsoid_count failed: " + libraryReason(r));
+    ellipsoid_capacity = ne;
+    st.has_under = true;
+    st.under_kind = replay::garmentKindName(opt.under_kind);
+    st.under_particles = under_vertices;
+  }
+
   // Pictures (drawn outside the timed calls) and the progress bar (a terminal only).
   replay::Pictures pictures;
   pictures.begin(opt, frames, info.nominal_rate_hz, fs::path(path).filename().string(),
-                 garment ? (st.garment_from_obj ? fs::path(opt.garment_obj).filename().string() : st.garment_kind)
+                 garment ? (st.garment_from_obj ? fs::path(opt.garment_obj).filename().string() : st.garment_kind) +
+                               (under ? " OVER " + st.under_kind : std::string())
                          : std::string("NO GARMENT"),
                  st.render);
   if (render_due && !st.render.png_available && !opt.quiet)
     std::fprintf(stderr, "drape-replay: note: built without stb_image_write, so no pictures; install libstb-dev "
                          "(bash .ci/install-deps.sh) and rebuild\n");
+  if (under) pictures.setUnderGarment(&under_positions, &under_normals, &under_indices);
   replay::ProgressBar progress(frames, !opt.quiet && replay::stderrIsTerminal());
   double frame_timestamp = 0.0;
   auto renderFrame = [&](uint32_t index) {
@@ -508,11 +557,11 @@ int run(int argc, char** argv) {
     st.nonfinite += replay::countNonFinite(garment_positions) + replay::countNonFinite(garment_normals);
     st.stretch.addFrame(garment_positions);
     if (!st.body_stretch_set && i >= st.body_stretch_from_frame) {
-      const std::vector<uint32_t> under = replay::trianglesNear(
+      const std::vector<uint32_t> covered = replay::trianglesNear(
           indices, positions, garment_positions, replay::ReplayStats::kBodyUnderGarmentM,
           replay::ReplayStats::kBodyMinEdgeM);
-      st.body_stretch.setMesh(under, positions);
-      st.body_tube_stretch.setMesh(under, positions, st.ring_points + 1);
+      st.body_stretch.setMesh(covered, positions);
+      st.body_tube_stretch.setMesh(covered, positions, st.ring_points + 1);
       st.body_stretch_set = true;
     }
     if (st.body_stretch_set) {
@@ -520,6 +569,30 @@ int run(int argc, char** argv) {
       st.body_tube_stretch.addFrame(positions);
     }
 
+    if (under) {
+      if (drape_result r = drape_garment_read_mesh(under, under_positions.data(),
+                                                   under_normals.empty() ? nullptr : under_normals.data(),
+                                                   under_vertices, nullptr, 0))
+        return fail(kExitFailure, "drape_garment_read_mesh (--under) failed on frame " + std::to_string(i) + ": " +
+                                      libraryReason(r));
+      st.nonfinite += replay::countNonFinite(under_positions) + replay::countNonFinite(under_normals);
+      if (opt.measure_every != 0 && (st.cloth_ms.size() - 1) % opt.measure_every == 0) {
+        uint32_t got = 0;
+        ellipsoids.resize(ellipsoid_capacity);  // the context's count, fixed by its body
+        if (drape_result r = drape_context_read_ellipsoids(ctx.get(), ellipsoids.data(), ellipsoid_capacity, &got))
+          return fail(kExitFailure, "drape_context_read_ellipsoids failed: " + libraryReason(r));
+        ellipsoids.resize(got);
+        replay::addLayerCrossing(garment_positions, under_positions, ellipsoids, st.layer_crossing);
+      }
+      if (opt.write_obj) {
+        const fs::path obj = fs::path(opt.out_dir) / replay::underObjFileName(i);
+        const std::string comment = "drape-replay garment under (" + st.under_kind + "), frame " + std::to_string(i) +
+                                    ", t = " + std::to_string(timestamp) + " s, " + std::to_string(under_vertices) +
+                                    " vertices";
+        if (!replay::writeObj(obj.string(), under_positions, under_normals, under_indices, comment, error))
+          return fail(kExitFailure, error);
+      }
+    }
     if (opt.write_obj) {
       const fs::path obj = fs::path(opt.out_dir) / replay::garmentObjFileName(i);
       const std::string comment = "drape-replay garment " + st.garment_kind + ", frame " + std::to_string(i) +

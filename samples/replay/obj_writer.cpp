@@ -18,6 +18,12 @@ std::string garmentObjFileName(uint32_t frame_index) {
   return name;
 }
 
+std::string underObjFileName(uint32_t frame_index) {
+  char name[32];
+  std::snprintf(name, sizeof name, "under_%05u.obj", frame_index);
+  return name;
+}
+
 bool writeObj(const std::string& path, const std::vector<drape_vec3>& positions,
               const std::vector<drape_vec3>& normals, const std::vector<uint32_t>& indices,
               const std::string& comment, std::string& error) {

@@ -13,6 +13,8 @@ namespace replay {
 std::string objFileName(uint32_t frame_index);
 // "garment_00042.obj" for frame 42, written beside the body's.
 std::string garmentObjFileName(uint32_t frame_index);
+// "under_00042.obj": the garment worn under it (--under).
+std::string underObjFileName(uint32_t frame_index);
 
 // Writes the mesh to `path` (replacing it). Returns false and sets `error` on an I/O failure.
 bool writeObj(const std::string& path, const std::vector<drape_vec3>& positions,

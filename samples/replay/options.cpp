@@ -259,6 +259,15 @@ bool parseOptions(int argc, const char* const* argv, Options& o, std::string& er
         }
         o.garment_obj = value;
       }
+    } else if (name == "--under") {
+      if (!takeValue()) return false;
+      o.under_kind = -1;
+      for (const GarmentName& g : kGarmentNames)
+        if (value == g.name) o.under_kind = g.kind;
+      if (o.under_kind < 0) {
+        error = "--under '" + value + "' is not tshirt, longsleeve, skirt, dress or trousers (e.g. --under trousers)";
+        return false;
+      }
     } else if (name == "--particles") {
       if (!takeValue()) return false;
       if (!parseUint(value, 200, 200000, o.particles)) {
@@ -374,6 +383,10 @@ bool parseOptions(int argc, const char* const* argv, Options& o, std::string& er
             " has no effect with --garment none; drop it or choose a garment";
     return false;
   }
+  if (o.under_kind >= 0 && o.garment_none) {
+    error = "--under needs a garment to be worn over it; drop --garment none";
+    return false;
+  }
   if (o.strain_limit >= 0.0 && o.solver == DRAPE_SOLVER_MASS_SPRING) {
     error = "--strain-limit has no effect with --solver massspring (an XPBD setting); drop it";
     return false;
@@ -452,6 +465,10 @@ std::string helpText() {
       "                        (default 10; 0 = never; about 10 ms per measurement)\n"
       "  --garment G           tshirt (default), longsleeve, skirt, dress, trousers, none (no cloth:\n"
       "                        push + update only), or PATH.obj (a garment mesh, e.g. from MakeHuman)\n"
+      "  --under G             a template garment (tshirt, longsleeve, skirt, dress, trousers)\n"
+      "                        worn under the --garment one, which lies on it (layers 1 and 2:\n"
+      "                        docs/garments.md \"Layered garments\"); same --particles and\n"
+      "                        cloth options; drawn, written (under_NNNNN.obj) and measured\n"
       "  --particles N         template garment resolution, in [200, 200000] (default 2000)\n"
       "  --garment-fit F       by-kind (default: trousers and long-sleeve tops as skeleton, the\n"
       "                        others as shape), shape (the body shape's standard proportions) or\n"

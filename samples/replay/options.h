@@ -29,6 +29,9 @@ struct Options {
   // is an OBJ file added with drape_context_add_garment_obj_file and the default drape_mesh_fit.
   bool garment_none = false;
   int32_t garment_kind = DRAPE_GARMENT_TSHIRT;
+  // --under G: a template garment worn under the main one (drape_garment_set_layer: it 1, the main
+  // garment 2; docs/garments.md "Layered garments"); under_kind -1 = none.
+  int32_t under_kind = -1;
   std::string garment_obj;
   uint32_t particles = 0;          // 0: the library's template default (drape_garment_template_init)
   int32_t solver = DRAPE_SOLVER_XPBD;

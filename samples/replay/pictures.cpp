@@ -117,6 +117,16 @@ bool Pictures::addFrame(uint32_t index, double timestamp, const std::vector<drap
   meshes[0].indices = body_indices.data();
   meshes[0].index_count = static_cast<uint32_t>(body_indices.size());
   std::copy(kBodyColor, kBodyColor + 3, meshes[0].color);
+  if (under_positions_ && under_indices_ && !under_positions_->empty() && !under_indices_->empty()) {
+    MeshRef u;
+    u.positions = under_positions_->data();
+    u.normals = under_normals_ && under_normals_->size() == under_positions_->size() ? under_normals_->data() : nullptr;
+    u.vertex_count = static_cast<uint32_t>(under_positions_->size());
+    u.indices = under_indices_->data();
+    u.index_count = static_cast<uint32_t>(under_indices_->size());
+    std::copy(kUnderColor, kUnderColor + 3, u.color);
+    meshes.push_back(u);
+  }
   if (!garment_positions.empty() && !garment_indices.empty()) {
     MeshRef g;
     g.positions = garment_positions.data();

@@ -32,10 +32,22 @@ class Pictures {
                 const std::vector<drape_vec3>& garment_positions, const std::vector<drape_vec3>& garment_normals,
                 const std::vector<uint32_t>& garment_indices, RenderStats& stats, std::string& error);
 
+  // A garment worn under the garment (--under), drawn before it in kUnderColor from these buffers
+  // (the caller's, read at each addFrame; empty: not drawn).
+  void setUnderGarment(const std::vector<drape_vec3>* positions, const std::vector<drape_vec3>* normals,
+                       const std::vector<uint32_t>* indices) {
+    under_positions_ = positions;
+    under_normals_ = normals;
+    under_indices_ = indices;
+  }
+
   // Writes the contact sheet, closes the GIF, makes the MP4.
   bool finish(RenderStats& stats, std::string& error);
 
  private:
+  const std::vector<drape_vec3>* under_positions_ = nullptr;
+  const std::vector<drape_vec3>* under_normals_ = nullptr;
+  const std::vector<uint32_t>* under_indices_ = nullptr;
   void composeFrame(const std::vector<MeshRef>& meshes, bool labels, uint32_t index, double timestamp, Image& out);
 
   uint32_t every_ = 0;

@@ -9,6 +9,7 @@ namespace replay {
 // Colours (sRGB 0..1): a light grey-beige mannequin and a blue T-shirt on a pale background.
 const float kBodyColor[3] = {0.87f, 0.78f, 0.70f};
 const float kGarmentColor[3] = {0.16f, 0.42f, 0.78f};
+const float kUnderColor[3] = {0.16f, 0.17f, 0.22f};  // dark charcoal: trousers under a blue shirt
 const uint8_t kBackground[3] = {236, 239, 243};
 
 namespace {

@@ -66,6 +66,7 @@ struct MeshRef {
 
 extern const float kBodyColor[3];
 extern const float kGarmentColor[3];
+extern const float kUnderColor[3];  // a garment under the garment (--under)
 extern const uint8_t kBackground[3];
 
 class Rasterizer {

@@ -241,6 +241,21 @@ std::string statsJson(const ReplayStats& s) {
   w.key("nan_resets").value(s.nan_resets);
   w.key("contacts").value(median(s.contacts));
   w.key("substeps").value(median(s.substeps));
+  // --under: the garment worn under this one (null without it).
+  w.key("under");
+  if (s.has_under) {
+    w.beginObject();
+    w.key("kind").value(s.under_kind);
+    w.key("particles").value(s.under_particles);
+    w.key("crossing").beginObject();
+    w.key("frames").value(s.layer_crossing.frames);
+    w.key("over").value(static_cast<int64_t>(s.layer_crossing.over));
+    w.key("under_share").value(s.layer_crossing.underShare());
+    w.endObject();
+    w.endObject();
+  } else {
+    w.null();
+  }
   w.endObject();
 
   // What the adaptive pipeline skipped: ellipsoids built per frame (median) of those available,
@@ -338,6 +353,11 @@ std::string summaryText(const ReplayStats& s, const std::string& obj_dir, const 
           s.openings, s.openings_off_frames, s.penetration_p99_mm.size(), s.openings_off_max);
     appendf(o, "cloth       %.0f contacts, %.0f substeps per frame (median); %u teleport resets, %u NaN resets\n",
         median(s.contacts), median(s.substeps), s.teleport_resets, s.nan_resets);
+    if (s.has_under)
+      appendf(o, "under       %s (template, layer 1; the garment layer 2), %u particles; of the garment's vertices over "
+                 "it, %.2f %% lie under it (%llu vertex-frames, %u measured frames)\n",
+          s.under_kind.c_str(), s.under_particles, 100.0 * s.layer_crossing.underShare(),
+          static_cast<unsigned long long>(s.layer_crossing.over), s.layer_crossing.frames);
   } else {
     o += "garment     none\n";
   }
@@ -373,7 +393,8 @@ std::string summaryText(const ReplayStats& s, const std::string& obj_dir, const 
   }
   o += "\n";
   if (!obj_dir.empty())
-    o += "obj         " + obj_dir + "/body_NNNNN.obj" + (s.has_garment ? ", garment_NNNNN.obj" : "") + "\n";
+    o += "obj         " + obj_dir + "/body_NNNNN.obj" + (s.has_garment ? ", garment_NNNNN.obj" : "") +
+         (s.has_under ? ", under_NNNNN.obj" : "") + "\n";
   const RenderStats& r = s.render;
   if (!r.png_available && r.every != 0) {
     o += "pictures    none: this drape-replay was built without stb_image_write (install libstb-dev,\n"

@@ -4,6 +4,7 @@
 
 #include <drape/drape.h>
 
+#include "layering.h"
 #include "stretch.h"
 
 #include <cstdint>
@@ -103,6 +104,12 @@ struct ReplayStats {
   // Openings (drape_garment_accuracy.openings): those round a body part when dressed, measured
   // frames with one or more off it, and the most off in one frame.
   uint32_t openings = 0, openings_off_frames = 0, openings_off_max = 0;
+  // --under: the template garment worn under the garment (layer 1; the garment is layer 2), and on
+  // every measured frame the share of the garment's vertices over it that lie under it instead.
+  bool has_under = false;
+  std::string under_kind;
+  uint32_t under_particles = 0;
+  LayerCrossing layer_crossing;
 
   RenderStats render;
 

@@ -139,6 +139,11 @@ TEST(LayerOffsets, ChangeByAtMostTheStepLimits) {
   over.beginStep(1);
   over.endMeasure();
   EXPECT_FALSE(over.any());
+  // Unlimited (a garment's first step, which places it): the offset at once.
+  over.beginStep(1);
+  over.addUnder({0.025f});
+  over.endMeasure(/*limited=*/false);
+  EXPECT_EQ(over.offsets()[0], 0.025f);
   // reset() forgets: the next step starts from 0.
   over.beginStep(1);
   over.addUnder({0.005f});
@@ -262,11 +267,11 @@ LayeredRun runLayered(const std::string& path, int shirt_layer, int trousers_lay
   return out;
 }
 
-// A take, and how much of the crossing layering must take away there: on the gesture takes (legs
-// still) nearly all of it (0.10-0.27 of it left); on the close-range take 0.29, and on the CMU walks
-// and hops (legs swinging under the shirt's hem) 0.40-0.58, what is left being mostly trousers
-// cloth farther than the reach off the pelvis (3.5-5.5 cm at the walks' seats: loose cloth, not a
-// shell) (docs/garments.md, "Layered garments").
+// A take, and how much of the crossing layering must leave at most: on the gesture takes (legs
+// still) 0.12-0.27 of it is left; on the close-range take 0.43, on the CMU walks and hops (legs
+// swinging under the shirt's hem) 0.36-0.58, mostly trousers cloth farther than the reach off the
+// pelvis (3.5-5.5 cm at the walks' seats: loose cloth, not a shell) (docs/garments.md, "Layered
+// garments").
 struct LayerTake {
   const char* file;
   double max_under_ratio;
@@ -303,9 +308,9 @@ TEST_P(GarmentLayersOnRecording, ATShirtOverTrousersLiesOnThem) {
   EXPECT_LE(largest, ClothShell::kReachM);
   EXPECT_TRUE(layered.shirt.finite);
   EXPECT_EQ(layered.shirt.nan_resets, 0);
-  // The shirt, cut for the body, stretches round the trousers: 1.10-1.13 x its median P99 on the
-  // gesture takes, 1.8-2.0 x (0.18-0.20) on the close-range and CMU ones (a looser shirt stretches
-  // less: docs/garments.md); bounded, not a blow-up.
+  // The shirt, cut for the body, stretches round the trousers: 1.13 x its median P99 on the
+  // gesture takes, 1.4 x on the close-range one and 1.7-1.9 x (0.17-0.19) on the CMU ones (a
+  // looser shirt stretches less: docs/garments.md); bounded, not a blow-up.
   EXPECT_LT(layered.shirt.p99_stretch_median, 0.3f);
   // One-way: the trousers under the shirt are the trousers alone, to the bit.
   ASSERT_EQ(layered.trousers_end.size(), flat.trousers_end.size());
@@ -315,10 +320,10 @@ TEST_P(GarmentLayersOnRecording, ATShirtOverTrousersLiesOnThem) {
 }
 
 const LayerTake kLayerTakes[] = {
-    {"kinect_v2_msft_labanotation/Ges01_wavehand.csv", 0.3},
-    {"kinect_v2_msft_labanotation/Ges02_balancinghands.csv", 0.3},
-    {"kinect_v2_msft_labanotation/Ges04_comehere.csv", 0.3},
-    {"kinect_v2_msft_labanotation/KinectReader_joints_closerange.csv", 0.5},
+    {"kinect_v2_msft_labanotation/Ges01_wavehand.csv", 0.35},
+    {"kinect_v2_msft_labanotation/Ges02_balancinghands.csv", 0.35},
+    {"kinect_v2_msft_labanotation/Ges04_comehere.csv", 0.35},
+    {"kinect_v2_msft_labanotation/KinectReader_joints_closerange.csv", 0.55},
     {"cmu_mocap_bvh/131_01.bvh", 0.7},
     {"cmu_mocap_bvh/131_03.bvh", 0.7},
     {"cmu_mocap_bvh/scaled_131_01.bvh", 0.7},

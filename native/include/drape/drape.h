@@ -725,7 +725,9 @@ typedef struct drape_garment_stats {
   uint32_t refits;          /* times the garment was cut again (a body shape change, the skeleton's
                                calibration: drape_garment_fit); its rest shape
                                (drape_garment_read_rest_positions) changes then, nothing else */
-  double step_ms;           /* wall time of the garment's last step */
+  double step_ms;           /* wall time of the garment's last step (its own: on the CPU the
+                               other garments stepped in the same drape_context_step are not in it;
+                               a device frame run in a batched launch counts the whole launch) */
   double collide_ms;        /* of which ellipsoid collision; 0 on the OpenCL backend, where
                                collision runs inside the device frame (docs/opencl.md) */
   double integrate_ms;      /* the rest: integration and constraints; on OpenCL the whole

@@ -578,19 +578,27 @@ const std::vector<float>* Context::garmentLayerOffsets(const GarmentSim* garment
 }
 
 void Context::measureLayers(size_t count) {
-  // A garment's cloth is measured when another lies over it. A garment not yet stepped lies on its
-  // rest pose, not on this body: it counts from its first step.
+  // A garment's cloth is measured when another lies over it: where its last step left it, on
+  // stepEllipsoids_; a garment not yet stepped where it was dressed, on its cut's rest body (the
+  // offsets are distances off the ellipsoids, the same in any pose), so that garments placed
+  // together on the first frame are layered from it.
   const auto under = [&](size_t j, int32_t over) {
     const int32_t l = garmentLayers_[j].layer;
-    return l >= 1 && l < over && garments_[j]->steps() > 0;
+    return l >= 1 && l < over;
   };
   for (size_t j = 0; j < garments_.size(); ++j) {
     bool covered = false;
     for (size_t i = 0; i < garments_.size() && !covered; ++i) covered = i != j && under(j, garmentLayers_[i].layer);
-    if (covered)
-      garmentLayers_[j].shell.measure(garments_[j]->positions(), garments_[j]->particleCount(), stepEllipsoids_);
-    else
+    const GarmentSim& g = *garments_[j];
+    if (!covered) {
       garmentLayers_[j].shell.forgetHosts();
+    } else if (g.steps() == 0) {
+      garmentLayers_[j].shell.forgetHosts();  // dressed: new positions, then the body's
+      garmentLayers_[j].shell.measure(g.positions(), g.particleCount(), restEllipsoids(garmentCuts_[j].cut));
+      garmentLayers_[j].shell.forgetHosts();
+    } else {
+      garmentLayers_[j].shell.measure(g.positions(), g.particleCount(), stepEllipsoids_);
+    }
   }
   for (size_t i = 0; i < garments_.size(); ++i) {
     GarmentLayer& me = garmentLayers_[i];
@@ -601,7 +609,8 @@ void Context::measureLayers(size_t count) {
     me.over.beginStep(count);
     for (size_t j = 0; j < garments_.size(); ++j)
       if (j != i && under(j, me.layer)) me.over.addUnder(garmentLayers_[j].shell.offsets());
-    me.over.endMeasure();
+    // A garment's first step places it on the body: no motion to limit (docs/garments.md).
+    me.over.endMeasure(/*limited=*/garments_[i]->steps() > 0);
   }
 }
 

@@ -101,8 +101,9 @@ class Context {
   static constexpr int32_t kMaxGarmentLayer = 255;
   bool setGarmentLayer(const GarmentSim* garment, int32_t layer);
   int32_t garmentLayer(const GarmentSim* garment) const;
-  // How far the cloth under a layered garment stood off each ellipsoid in its last step (m; empty
-  // when nothing was under it). For tests and diagnostics.
+  // The offsets a layered garment stepped with last (m, one per ellipsoid: how far the cloth under
+  // it stood off each, within the step limits; empty for a garment of layer 0 or 1, zeros when
+  // nothing lies under it). For tests and diagnostics; null when the garment is not this context's.
   const std::vector<float>* garmentLayerOffsets(const GarmentSim* garment) const;
   size_t garmentCount() const { return garments_.size(); }
   GarmentSim& garment(size_t i) { return *garments_[i]; }

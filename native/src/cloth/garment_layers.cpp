@@ -109,8 +109,9 @@ bool LayerOffsets::any() const {
          std::any_of(previous_.begin(), previous_.end(), positive);
 }
 
-void LayerOffsets::endMeasure() {
+void LayerOffsets::endMeasure(bool limited) {
   previous_.resize(offsets_.size(), 0.0f);
+  if (!limited) return;
   for (size_t k = 0; k < offsets_.size(); ++k) {
     const float p = previous_[k];
     offsets_[k] = std::max(0.0f, std::clamp(offsets_[k], p - kMaxShrinkM, p + kMaxGrowthM));

@@ -87,8 +87,8 @@ class LayerOffsets {
   // A shell under the garment: the new offsets are the largest of the shells added.
   void addUnder(const std::vector<float>& shell);
   // Ends the step's measure: each new offset is limited to the last step's +kMaxGrowthM /
-  // -kMaxShrinkM (and 0).
-  void endMeasure();
+  // -kMaxShrinkM (and 0), unless !limited (a garment's first step, which places it).
+  void endMeasure(bool limited = true);
   const std::vector<float>& offsets() const { return offsets_; }
   const std::vector<float>& startOffsets() const { return previous_; }
   bool any() const;  // an offset, new or at the start, above 0

@@ -754,9 +754,12 @@ void GarmentSim::stepBegin(const BodyModel& body, const std::vector<Ellipsoid>& 
     }
   }
   allow_staging_ = false;
+  begin_ms_ = msSince(pending_t0_);
 }
 
 void GarmentSim::stepEnd() {
+  const Clock::time_point end_t0 = Clock::now();
+  const bool was_staged = staged_;
   // The staged frame (if any) has run: its statistics now, as runFrame counts an unstaged one.
   if (staged_) addFrameStats(staged_substeps_);
   staged_ = false;
@@ -779,7 +782,10 @@ void GarmentSim::stepEnd() {
   seen_pelvis_f_ = pr.frame;
   keepCalmState(pr);
   ++steps_;
-  last_.total_ms = msSince(pending_t0_);
+  // The garment's own time: its stepBegin (where a CPU frame runs) and this. The context steps
+  // every garment's stepBegin before any stepEnd, so the time in between is the others' frames;
+  // a staged device frame ran in the batched launch in between, which it counts whole.
+  last_.total_ms = was_staged ? msSince(pending_t0_) : begin_ms_ + msSince(end_t0);
 }
 
 const std::vector<Vec3>& GarmentSim::normals() const {

@@ -339,6 +339,7 @@ class GarmentSim {
   const BodyModel* pending_body_ = nullptr;  // stepBegin's arguments, for stepEnd
   const std::vector<Ellipsoid>* pending_end_ = nullptr;
   std::chrono::steady_clock::time_point pending_t0_{};
+  double begin_ms_ = 0.0;  // the last stepBegin's own time (GarmentStepStats::total_ms)
   // The pelvis turned farther since the last step than a person can turn in dt.
   bool poseJumped(const RingPose& pelvis, float dt) const;
   void carry(const Mat3& R, const Vec3& pivot, const Vec3& t, float velocity_scale);
