@@ -163,6 +163,38 @@ namespace Drape.Tests
         }
 
         [Fact]
+        public void DrapeDresser_GarmentUnder_IsLayeredAndUpdatedEveryFrame()
+        {
+            var go = new GameObject("person");
+            var source = go.AddComponent<RecordingJointSourceBehaviour>();
+            Set(source, "recording", new TextAsset(SyntheticKinect2.Csv(30)));
+            MeshFilter shirtFilter = go.AddComponent<MeshFilter>();
+            var underGo = new GameObject("trousers");
+            MeshFilter underFilter = underGo.AddComponent<MeshFilter>();
+            var dresser = go.AddComponent<DrapeDresser>();
+            Set(dresser, "particles", 400);
+            Set(dresser, "garmentMesh", shirtFilter);
+            Set(dresser, "underMesh", underFilter);
+            Message(dresser, "OnEnable");
+            Assert.True(dresser.enabled, string.Join("\n", UnityEngine.Debug.StandInLog));
+            Assert.NotNull(dresser.UnderGarment);
+            Assert.Equal(1, dresser.UnderGarment.Layer);
+            Assert.Equal(2, dresser.Garment.Layer);
+            Mesh under = underFilter.sharedMesh!;
+            Assert.Equal(dresser.UnderGarment.IndexCount, under.StandInTriangles!.Length);
+            Time.deltaTime = 1f / 30f;
+            for (int i = 0; i < 10; ++i) Message(dresser, "Update");
+            Assert.Equal(1 + 10, under.StandInVertexWrites);
+            // What the Mesh got is the trousers, in Unity's space (x negated).
+            var raw = new Vector3f[dresser.UnderGarment.VertexCount];
+            dresser.UnderGarment.ReadPositions(raw);
+            Vector3[] v = under.StandInVertices!;
+            for (int i = 0; i < raw.Length; ++i) Assert.Equal(-raw[i].X, v[i].x);
+            Message(dresser, "OnDisable");
+            Assert.Null(dresser.UnderGarment);
+        }
+
+        [Fact]
         public void DrapeDresser_ArmsClearTorso_ReachesTheContext()
         {
             Vector3[] BodyAfterUpdates(bool armsClear)

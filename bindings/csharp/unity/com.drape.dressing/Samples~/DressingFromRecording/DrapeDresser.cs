@@ -1,5 +1,5 @@
 // Drape sample (Unity): dresses the person a joint source sees and updates the garment's Mesh, and
-// optionally the body's, every frame. The joint source is pluggable: any component implementing
+// optionally a garment worn under it and the body's, every frame. The joint source is pluggable: any component implementing
 // Drape.IJointSource (RecordingJointSourceBehaviour from the package, KinectV2JointSourceBehaviour
 // below with DRAPE_KINECT_V2 defined, your own), or any IJointSource set from code (JointSource,
 // e.g. an AzureKinectJointSource). docs/unity.md walks through the setup.
@@ -34,6 +34,12 @@ namespace Drape.Samples
         [Tooltip("Normals from Drape (true) or Mesh.RecalculateNormals (false).")]
         [SerializeField] private bool drapeNormals = true;
 
+        [Header("Garment under it (optional)")]
+        [Tooltip("Receives the mesh of a second garment worn under the first (its sharedMesh is replaced); leave empty for one garment. The first garment then lies on it (layers: docs/garments.md, \"Layered garments\").")]
+        [SerializeField] private MeshFilter underMesh = null;
+        [Tooltip("The garment worn under the first one (same particles and cut).")]
+        [SerializeField] private GarmentKind underGarment = GarmentKind.Trousers;
+
         [Header("Body (optional)")]
         [Tooltip("Receives the body mesh; leave empty not to read the body.")]
         [SerializeField] private MeshFilter bodyMesh = null;
@@ -46,9 +52,9 @@ namespace Drape.Samples
 
         private IJointSource _sourceFromCode;
         private DressingLoop _loop;
-        private Garment _garment;
-        private Mesh _garmentMesh, _bodyMesh;
-        private Vector3[] _garmentPositions, _garmentNormals, _bodyPositions, _bodyNormals;
+        private Garment _garment, _under;
+        private Mesh _garmentMesh, _underMesh, _bodyMesh;
+        private Vector3[] _garmentPositions, _garmentNormals, _underPositions, _underNormals, _bodyPositions, _bodyNormals;
 
         /// <summary>A joint source set from code (before the component is enabled); it wins over
         /// the serialized component.</summary>
@@ -63,6 +69,9 @@ namespace Drape.Samples
 
         /// <summary>The garment (null while disabled).</summary>
         public Garment Garment => _garment;
+
+        /// <summary>The garment worn under it (null while disabled or without an under mesh).</summary>
+        public Garment UnderGarment => _under;
 
         private IJointSource FindSource()
         {
@@ -97,6 +106,21 @@ namespace Drape.Samples
                 _garmentMesh = DrapeUnity.CreateDynamicMesh("Drape garment", _garmentPositions, triangles);
                 if (garmentMesh != null) garmentMesh.sharedMesh = _garmentMesh;
 
+                if (underMesh != null)
+                {
+                    GarmentTemplate underTmpl = GarmentTemplate.CreateDefault(underGarment);
+                    if (particles > 0) underTmpl.Particles = (uint)particles;
+                    _under = _loop.Context.AddGarment(underTmpl, desc);
+                    _under.Layer = 1;     // next to the body
+                    _garment.Layer = 2;   // lies on it
+                    _underPositions = new Vector3[_under.VertexCount];
+                    _underNormals = new Vector3[_under.VertexCount];
+                    var underTriangles = new int[_under.IndexCount];
+                    MeshSpace.ReadGarmentTriangles(_under, underTriangles, axisFlip);
+                    _underMesh = DrapeUnity.CreateDynamicMesh("Drape garment under", _underPositions, underTriangles);
+                    underMesh.sharedMesh = _underMesh;
+                }
+
                 if (bodyMesh != null)
                 {
                     var (vertexCount, indexCount) = _loop.Context.GetBodyMeshSize();
@@ -129,6 +153,16 @@ namespace Drape.Samples
             else _garmentMesh.RecalculateNormals();
             _garmentMesh.RecalculateBounds();
 
+            if (_underMesh != null)
+            {
+                MeshSpace.ReadGarment(_under, _underPositions.AsDrape(),
+                                      drapeNormals ? _underNormals.AsDrape() : Span<Vector3f>.Empty, axisFlip);
+                _underMesh.SetVertices(_underPositions);
+                if (drapeNormals) _underMesh.SetNormals(_underNormals);
+                else _underMesh.RecalculateNormals();
+                _underMesh.RecalculateBounds();
+            }
+
             if (_bodyMesh != null)
             {
                 MeshSpace.ReadBody(_loop.Context, _bodyPositions.AsDrape(), _bodyNormals.AsDrape(), axisFlip);
@@ -142,12 +176,15 @@ namespace Drape.Samples
 
         private void Release()
         {
-            if (_loop != null) _loop.Dispose();   // the context and its garment
+            if (_loop != null) _loop.Dispose();   // the context and its garments
             _loop = null;
             _garment = null;
+            _under = null;
             if (_garmentMesh != null) Destroy(_garmentMesh);
+            if (_underMesh != null) Destroy(_underMesh);
             if (_bodyMesh != null) Destroy(_bodyMesh);
             _garmentMesh = null;
+            _underMesh = null;
             _bodyMesh = null;
         }
     }
