@@ -584,21 +584,21 @@ int run(int argc, char** argv) {
         ellipsoids.resize(got);
         replay::addLayerCrossing(garment_positions, under_positions, ellipsoids, st.layer_crossing);
       }
-      if (opt.write_obj) {
-        const fs::path obj = fs::path(opt.out_dir) / replay::underObjFileName(i);
-        const std::string comment = "drape-replay garment under (" + st.under_kind + "), frame " + std::to_string(i) +
-                                    ", t = " + std::to_string(timestamp) + " s, " + std::to_string(under_vertices) +
-                                    " vertices";
-        if (!replay::writeObj(obj.string(), under_positions, under_normals, under_indices, comment, error))
-          return fail(kExitFailure, error);
-      }
     }
     if (opt.write_obj) {
-      const fs::path obj = fs::path(opt.out_dir) / replay::garmentObjFileName(i);
-      const std::string comment = "drape-replay garment " + st.garment_kind + ", frame " + std::to_string(i) +
-                                  ", t = " + std::to_string(timestamp) + " s, " + std::to_string(garment_vertices) +
-                                  " vertices";
-      if (!replay::writeObj(obj.string(), garment_positions, garment_normals, garment_indices, comment, error))
+      // This frame's garment OBJ (and the one under it), its comment naming what it is.
+      const auto writeGarment = [&](const std::string& file, const std::string& what,
+                                    const std::vector<drape_vec3>& p, const std::vector<drape_vec3>& n,
+                                    const std::vector<uint32_t>& idx) {
+        const std::string comment = "drape-replay garment " + what + ", frame " + std::to_string(i) + ", t = " +
+                                    std::to_string(timestamp) + " s, " + std::to_string(p.size()) + " vertices";
+        return replay::writeObj((fs::path(opt.out_dir) / file).string(), p, n, idx, comment, error);
+      };
+      if (under && !writeGarment(replay::underObjFileName(i), "under (" + st.under_kind + ")", under_positions,
+                                 under_normals, under_indices))
+        return fail(kExitFailure, error);
+      if (!writeGarment(replay::garmentObjFileName(i), st.garment_kind, garment_positions, garment_normals,
+                        garment_indices))
         return fail(kExitFailure, error);
     }
     if (!renderFrame(i)) return fail(kExitFailure, error);

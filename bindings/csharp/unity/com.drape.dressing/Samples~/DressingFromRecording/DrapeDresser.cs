@@ -146,22 +146,8 @@ namespace Drape.Samples
             _loop.Tick(Time.deltaTime);
             if (!_loop.HasBody) return;   // no accepted frame yet
 
-            MeshSpace.ReadGarment(_garment, _garmentPositions.AsDrape(),
-                                  drapeNormals ? _garmentNormals.AsDrape() : Span<Vector3f>.Empty, axisFlip);
-            _garmentMesh.SetVertices(_garmentPositions);
-            if (drapeNormals) _garmentMesh.SetNormals(_garmentNormals);
-            else _garmentMesh.RecalculateNormals();
-            _garmentMesh.RecalculateBounds();
-
-            if (_underMesh != null)
-            {
-                MeshSpace.ReadGarment(_under, _underPositions.AsDrape(),
-                                      drapeNormals ? _underNormals.AsDrape() : Span<Vector3f>.Empty, axisFlip);
-                _underMesh.SetVertices(_underPositions);
-                if (drapeNormals) _underMesh.SetNormals(_underNormals);
-                else _underMesh.RecalculateNormals();
-                _underMesh.RecalculateBounds();
-            }
+            WriteGarment(_garment, _garmentMesh, _garmentPositions, _garmentNormals);
+            if (_underMesh != null) WriteGarment(_under, _underMesh, _underPositions, _underNormals);
 
             if (_bodyMesh != null)
             {
@@ -170,6 +156,16 @@ namespace Drape.Samples
                 _bodyMesh.SetNormals(_bodyNormals);
                 _bodyMesh.RecalculateBounds();
             }
+        }
+
+        /// <summary>A garment's positions (and normals) straight into its arrays, then its Mesh.</summary>
+        private void WriteGarment(Garment g, Mesh mesh, Vector3[] positions, Vector3[] normals)
+        {
+            MeshSpace.ReadGarment(g, positions.AsDrape(), drapeNormals ? normals.AsDrape() : Span<Vector3f>.Empty, axisFlip);
+            mesh.SetVertices(positions);
+            if (drapeNormals) mesh.SetNormals(normals);
+            else mesh.RecalculateNormals();
+            mesh.RecalculateBounds();
         }
 
         private void OnDisable() => Release();
