@@ -53,19 +53,36 @@ Host hostOf(const drape_vec3& p, const std::vector<drape_ellipsoid>& e) {
 
 void addLayerCrossing(const std::vector<drape_vec3>& outer, const std::vector<drape_vec3>& inner,
                       const std::vector<drape_ellipsoid>& ellipsoids, LayerCrossing& crossing) {
-  // The inner vertices by ellipsoid, so that an outer vertex looks at those on its own only.
-  std::vector<Host> hin(inner.size());
-  std::vector<std::vector<uint32_t>> on(ellipsoids.size());
+  // The inner vertices by ellipsoid (a counting sort), so that an outer vertex looks at those on
+  // its own only.
+  std::vector<int>& hk = crossing.inner_host;
+  std::vector<float>& hd = crossing.inner_dist;
+  std::vector<uint32_t>& start = crossing.by_ellipsoid_start;
+  std::vector<uint32_t>& items = crossing.by_ellipsoid;
+  hk.resize(inner.size());
+  hd.resize(inner.size());
+  start.assign(ellipsoids.size() + 1, 0);
   for (size_t j = 0; j < inner.size(); ++j) {
-    hin[j] = hostOf(inner[j], ellipsoids);
-    if (hin[j].k >= 0) on[static_cast<size_t>(hin[j].k)].push_back(static_cast<uint32_t>(j));
+    const Host h = hostOf(inner[j], ellipsoids);
+    hk[j] = h.k;
+    hd[j] = h.d;
+    if (h.k >= 0) ++start[static_cast<size_t>(h.k) + 1];
   }
+  for (size_t k = 0; k < ellipsoids.size(); ++k) start[k + 1] += start[k];
+  items.resize(start[ellipsoids.size()]);
+  // Each bucket in ascending j (start[k] advances to the bucket's end, then all shift back), so
+  // the nearest inner vertex is the first of equals, as a scan over every inner vertex finds it.
+  for (size_t j = 0; j < inner.size(); ++j)
+    if (hk[j] >= 0) items[start[static_cast<size_t>(hk[j])]++] = static_cast<uint32_t>(j);
+  for (size_t k = ellipsoids.size(); k > 0; --k) start[k] = start[k - 1];
+  start[0] = 0;
   for (const drape_vec3& p : outer) {
     const Host h = hostOf(p, ellipsoids);
     if (h.k < 0) continue;
     float nearest = kNearM * kNearM;
     int jn = -1;
-    for (uint32_t j : on[static_cast<size_t>(h.k)]) {
+    for (uint32_t t = start[static_cast<size_t>(h.k)]; t < start[static_cast<size_t>(h.k) + 1]; ++t) {
+      const uint32_t j = items[t];
       const float dx = inner[j].x - p.x, dy = inner[j].y - p.y, dz = inner[j].z - p.z;
       const float d2 = dx * dx + dy * dy + dz * dz;
       if (d2 < nearest) {
@@ -75,7 +92,7 @@ void addLayerCrossing(const std::vector<drape_vec3>& outer, const std::vector<dr
     }
     if (jn < 0) continue;
     ++crossing.over;
-    if (h.d < hin[static_cast<size_t>(jn)].d - kUnderM) ++crossing.under;
+    if (h.d < hd[static_cast<size_t>(jn)] - kUnderM) ++crossing.under;
   }
   ++crossing.frames;
 }

@@ -15,6 +15,11 @@ struct LayerCrossing {
   uint64_t under = 0;  // of those, nearer that ellipsoid than the nearest such inner vertex by > 1 mm
   uint32_t frames = 0;
   double underShare() const { return over > 0 ? static_cast<double>(under) / static_cast<double>(over) : 0.0; }
+  // addLayerCrossing's scratch (each inner vertex's ellipsoid and distance, the inner vertices by
+  // ellipsoid), kept so that a frame allocates nothing once the sizes settle.
+  std::vector<int> inner_host;
+  std::vector<float> inner_dist;
+  std::vector<uint32_t> by_ellipsoid_start, by_ellipsoid;
 };
 
 // Each vertex lies on the ellipsoid it is deepest in or nearest to (the smallest |q| in its unit

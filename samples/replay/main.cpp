@@ -56,6 +56,38 @@ std::string libraryReason(drape_result r) {
   return s;
 }
 
+// A garment's mesh as drape-replay reads it: sizes and indices once (load), positions (and the
+// normals, when `normals` was asked for) every frame (read). `which` names the garment in errors.
+struct GarmentMesh {
+  uint32_t vertices = 0, index_count = 0;
+  std::vector<drape_vec3> positions, normals;
+  std::vector<uint32_t> indices;
+
+  bool load(drape_garment* g, bool with_normals, const std::string& which, std::string& error) {
+    if (drape_result r = drape_garment_get_mesh_size(g, &vertices, &index_count)) {
+      error = "drape_garment_get_mesh_size" + which + " failed: " + libraryReason(r);
+      return false;
+    }
+    positions.resize(vertices);
+    if (with_normals) normals.resize(vertices);
+    indices.resize(index_count);
+    if (drape_result r = drape_garment_read_mesh(g, nullptr, nullptr, 0, indices.data(), index_count)) {
+      error = "drape_garment_read_mesh" + which + " (indices) failed: " + libraryReason(r);
+      return false;
+    }
+    return true;
+  }
+  bool read(drape_garment* g, uint32_t frame, const std::string& which, std::string& error) {
+    if (drape_result r = drape_garment_read_mesh(g, positions.data(), normals.empty() ? nullptr : normals.data(),
+                                                 vertices, nullptr, 0)) {
+      error = "drape_garment_read_mesh" + which + " failed on frame " + std::to_string(frame) + ": " +
+              libraryReason(r);
+      return false;
+    }
+    return true;
+  }
+};
+
 struct RecordingDeleter {
   void operator()(drape_recording* r) const { drape_recording_destroy(r); }
 };
@@ -306,23 +338,14 @@ int run(int argc, char** argv) {
   const bool watertight = replay::isWatertight(indices, vertex_count);
 
   // Garment mesh: sizes, indices and rest shape are fixed for the garment; read them once.
-  uint32_t garment_vertices = 0, garment_index_count = 0;
-  std::vector<drape_vec3> garment_positions, garment_normals;
-  std::vector<uint32_t> garment_indices;
+  GarmentMesh garment_mesh;
   if (garment) {
-    if (drape_result r = drape_garment_get_mesh_size(garment, &garment_vertices, &garment_index_count))
-      return fail(kExitFailure, "drape_garment_get_mesh_size failed: " + libraryReason(r));
-    garment_positions.resize(garment_vertices);
-    if (opt.write_obj || render_due) garment_normals.resize(garment_vertices);
-    garment_indices.resize(garment_index_count);
-    if (drape_result r = drape_garment_read_mesh(garment, nullptr, nullptr, 0, garment_indices.data(),
-                                                 garment_index_count))
-      return fail(kExitFailure, "drape_garment_read_mesh (indices) failed: " + libraryReason(r));
-    std::vector<drape_vec3> rest(garment_vertices);
-    if (drape_result r = drape_garment_read_rest_positions(garment, rest.data(), garment_vertices))
+    if (!garment_mesh.load(garment, opt.write_obj || render_due, "", error)) return fail(kExitFailure, error);
+    std::vector<drape_vec3> rest(garment_mesh.vertices);
+    if (drape_result r = drape_garment_read_rest_positions(garment, rest.data(), garment_mesh.vertices))
       return fail(kExitFailure, "drape_garment_read_rest_positions failed: " + libraryReason(r));
     st.nonfinite += replay::countNonFinite(rest);
-    st.stretch.setMesh(garment_indices, rest);
+    st.stretch.setMesh(garment_mesh.indices, rest);
 
     drape_cloth_params actual;
     drape_cloth_params_init(&actual);
@@ -340,8 +363,8 @@ int run(int argc, char** argv) {
     st.iterations = actual.iterations;
     st.strain_limit = actual.strain_limit;
     st.collision_stride = actual.collision_stride;
-    st.particles = garment_vertices;
-    st.garment_triangles = garment_index_count / 3;
+    st.particles = garment_mesh.vertices;
+    st.garment_triangles = garment_mesh.index_count / 3;
     st.attached = gs.attached;
     st.cloth_ms.reserve(frames);
     st.integrate_ms.reserve(frames);
@@ -364,26 +387,18 @@ int run(int argc, char** argv) {
 
   // --under: its mesh (indices once; positions and normals per frame) and the ellipsoids its
   // crossing is measured against.
-  uint32_t under_vertices = 0, under_index_count = 0;
-  std::vector<drape_vec3> under_positions, under_normals;
-  std::vector<uint32_t> under_indices;
+  GarmentMesh under_mesh;
   std::vector<drape_ellipsoid> ellipsoids;
   uint32_t ellipsoid_capacity = 0;
   if (under) {
-    if (drape_result r = drape_garment_get_mesh_size(under, &under_vertices, &under_index_count))
-      return fail(kExitFailure, "drape_garment_get_mesh_size (--under) failed: " + libraryReason(r));
-    under_positions.resize(under_vertices);
-    if (opt.write_obj || render_due) under_normals.resize(under_vertices);
-    under_indices.resize(under_index_count);
-    if (drape_result r = drape_garment_read_mesh(under, nullptr, nullptr, 0, under_indices.data(), under_index_count))
-      return fail(kExitFailure, "drape_garment_read_mesh (--under indices) failed: " + libraryReason(r));
+    if (!under_mesh.load(under, opt.write_obj || render_due, " (--under)", error)) return fail(kExitFailure, error);
     uint32_t ne = 0;
     if (drape_result r = drape_context_get_ellipsoid_count(ctx.get(), &ne))
       return fail(kExitFailure, "drape_context_get_ellipsoid_count failed: " + libraryReason(r));
     ellipsoid_capacity = ne;
     st.has_under = true;
     st.under_kind = replay::garmentKindName(opt.under_kind);
-    st.under_particles = under_vertices;
+    st.under_particles = under_mesh.vertices;
   }
 
   // Pictures (drawn outside the timed calls) and the progress bar (a terminal only).
@@ -396,7 +411,7 @@ int run(int argc, char** argv) {
   if (render_due && !st.render.png_available && !opt.quiet)
     std::fprintf(stderr, "drape-replay: note: built without stb_image_write, so no pictures; install libstb-dev "
                          "(bash .ci/install-deps.sh) and rebuild\n");
-  if (under) pictures.setUnderGarment(&under_positions, &under_normals, &under_indices);
+  if (under) pictures.setUnderGarment(&under_mesh.positions, &under_mesh.normals, &under_mesh.indices);
   replay::ProgressBar progress(frames, !opt.quiet && replay::stderrIsTerminal());
   double frame_timestamp = 0.0;
   auto renderFrame = [&](uint32_t index) {
@@ -404,8 +419,8 @@ int run(int argc, char** argv) {
     static const std::vector<drape_vec3> kNoVertices;
     static const std::vector<uint32_t> kNoIndices;
     return pictures.addFrame(index, frame_timestamp, positions, normals, indices,
-                             garment ? garment_positions : kNoVertices, garment ? garment_normals : kNoVertices,
-                             garment ? garment_indices : kNoIndices, st.render, error);
+                             garment ? garment_mesh.positions : kNoVertices, garment ? garment_mesh.normals : kNoVertices,
+                             garment ? garment_mesh.indices : kNoIndices, st.render, error);
   };
 
   using Clock = std::chrono::steady_clock;
@@ -520,8 +535,8 @@ int run(int argc, char** argv) {
     st.teleport_resets += gs.teleport_reset ? 1u : 0u;
     if (gs.refits != st.refits) {
       // Cut again (the skeleton's calibration): stretch from now on is against the new rest shape.
-      std::vector<drape_vec3> rest(garment_vertices);
-      if (drape_result r = drape_garment_read_rest_positions(garment, rest.data(), garment_vertices))
+      std::vector<drape_vec3> rest(garment_mesh.vertices);
+      if (drape_result r = drape_garment_read_rest_positions(garment, rest.data(), garment_mesh.vertices))
         return fail(kExitFailure, "drape_garment_read_rest_positions failed: " + libraryReason(r));
       st.nonfinite += replay::countNonFinite(rest);
       st.stretch.setRest(rest);
@@ -548,17 +563,12 @@ int run(int argc, char** argv) {
       st.openings_off_max = std::max(st.openings_off_max, acc.openings_off);
     }
 
-    if (drape_result r = drape_garment_read_mesh(garment, garment_positions.data(),
-                                                 garment_normals.empty() ? nullptr : garment_normals.data(),
-                                                 garment_vertices,
-                                                 nullptr, 0))
-      return fail(kExitFailure, "drape_garment_read_mesh failed on frame " + std::to_string(i) + ": " +
-                                    libraryReason(r));
-    st.nonfinite += replay::countNonFinite(garment_positions) + replay::countNonFinite(garment_normals);
-    st.stretch.addFrame(garment_positions);
+    if (!garment_mesh.read(garment, i, "", error)) return fail(kExitFailure, error);
+    st.nonfinite += replay::countNonFinite(garment_mesh.positions) + replay::countNonFinite(garment_mesh.normals);
+    st.stretch.addFrame(garment_mesh.positions);
     if (!st.body_stretch_set && i >= st.body_stretch_from_frame) {
       const std::vector<uint32_t> covered = replay::trianglesNear(
-          indices, positions, garment_positions, replay::ReplayStats::kBodyUnderGarmentM,
+          indices, positions, garment_mesh.positions, replay::ReplayStats::kBodyUnderGarmentM,
           replay::ReplayStats::kBodyMinEdgeM);
       st.body_stretch.setMesh(covered, positions);
       st.body_tube_stretch.setMesh(covered, positions, st.ring_points + 1);
@@ -570,19 +580,15 @@ int run(int argc, char** argv) {
     }
 
     if (under) {
-      if (drape_result r = drape_garment_read_mesh(under, under_positions.data(),
-                                                   under_normals.empty() ? nullptr : under_normals.data(),
-                                                   under_vertices, nullptr, 0))
-        return fail(kExitFailure, "drape_garment_read_mesh (--under) failed on frame " + std::to_string(i) + ": " +
-                                      libraryReason(r));
-      st.nonfinite += replay::countNonFinite(under_positions) + replay::countNonFinite(under_normals);
+      if (!under_mesh.read(under, i, " (--under)", error)) return fail(kExitFailure, error);
+      st.nonfinite += replay::countNonFinite(under_mesh.positions) + replay::countNonFinite(under_mesh.normals);
       if (opt.measure_every != 0 && (st.cloth_ms.size() - 1) % opt.measure_every == 0) {
         uint32_t got = 0;
         ellipsoids.resize(ellipsoid_capacity);  // the context's count, fixed by its body
         if (drape_result r = drape_context_read_ellipsoids(ctx.get(), ellipsoids.data(), ellipsoid_capacity, &got))
           return fail(kExitFailure, "drape_context_read_ellipsoids failed: " + libraryReason(r));
         ellipsoids.resize(got);
-        replay::addLayerCrossing(garment_positions, under_positions, ellipsoids, st.layer_crossing);
+        replay::addLayerCrossing(garment_mesh.positions, under_mesh.positions, ellipsoids, st.layer_crossing);
       }
     }
     if (opt.write_obj) {
@@ -594,11 +600,11 @@ int run(int argc, char** argv) {
                                     std::to_string(timestamp) + " s, " + std::to_string(p.size()) + " vertices";
         return replay::writeObj((fs::path(opt.out_dir) / file).string(), p, n, idx, comment, error);
       };
-      if (under && !writeGarment(replay::underObjFileName(i), "under (" + st.under_kind + ")", under_positions,
-                                 under_normals, under_indices))
+      if (under && !writeGarment(replay::underObjFileName(i), "under (" + st.under_kind + ")", under_mesh.positions,
+                                 under_mesh.normals, under_mesh.indices))
         return fail(kExitFailure, error);
-      if (!writeGarment(replay::garmentObjFileName(i), st.garment_kind, garment_positions, garment_normals,
-                        garment_indices))
+      if (!writeGarment(replay::garmentObjFileName(i), st.garment_kind, garment_mesh.positions, garment_mesh.normals,
+                        garment_mesh.indices))
         return fail(kExitFailure, error);
     }
     if (!renderFrame(i)) return fail(kExitFailure, error);
