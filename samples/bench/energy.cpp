@@ -78,6 +78,7 @@ bool energyDrift(const Setting& s, double seconds, EnergyDrift& out, std::string
   p.max_speed = 0.0f;
   p.iterations = static_cast<int>(s.iterations);
   p.strain_limit = s.strain_limit;
+  p.strain_limit_passes = static_cast<int>(s.strain_limit_passes);
   drape::XpbdSolver solver(t);
   if (!solver.setParams(p, error)) return false;
   return run(solver, g, frames, substeps, scale, out);

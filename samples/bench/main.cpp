@@ -186,6 +186,7 @@ struct Runner {
     // and in the strain limit: at the reference's 16x the substeps a chain's stretch is 1/256 of
     // the default's, so the limit hardly acts there; one reference prices every limit.
     ref_key_setting.strain_limit = Setting{}.strain_limit;
+    ref_key_setting.strain_limit_passes = Setting{}.strain_limit_passes;
     const Setting ref = ref_key_setting.reference(opt.quick);
     const std::string ref_id = ref.key() + "|" + take.name;
     if (!references.count(ref_id)) {
@@ -212,8 +213,8 @@ struct Runner {
     fillTimes(frames, take.rate_hz, r);
     // Energy drift of the free-hanging garment (independent of the take and the body proxies).
     char ekey[128];
-    std::snprintf(ekey, sizeof ekey, "%d %g %u %g %u", s.solver, s.substep_hz, s.iterations, s.strain_limit,
-                  s.particles);
+    std::snprintf(ekey, sizeof ekey, "%d %g %u %g %u %u", s.solver, s.substep_hz, s.iterations, s.strain_limit,
+                  s.strain_limit_passes, s.particles);
     if (!energies.count(ekey)) {
       EnergyDrift e;
       if (!energyDrift(s, energy_seconds, e, err)) return false;

@@ -53,7 +53,8 @@ bool writeRowsCsv(const std::string& path, const std::vector<Row>& rows, std::st
   // Text columns first (sweep .. backend), every later column numeric.
   std::fputs(
       "sweep,label,take,solver,contact_response,backend,is_default,rate_hz,substep_hz,iterations,"
-      "ring_points,continuous_collision,strain_limit,particles,repeats,timed_frames,substeps_per_frame,"
+      "ring_points,continuous_collision,strain_limit,strain_limit_passes,particles,repeats,timed_frames,"
+      "substeps_per_frame,"
       "frame_ms_median,frame_ms_p90,skeleton_ms_median,skeleton_ms_p90,body_ms_median,body_ms_p90,"
       "proxies_ms_median,proxies_ms_p90,cloth_ms_median,cloth_ms_p90,integrate_ms_median,integrate_ms_p90,"
       "collide_ms_median,collide_ms_p90,ms_per_sim_s,dev_rms_mm,dev_max_mm,stretch_p99_pct,stretch_max_pct,"
@@ -63,12 +64,13 @@ bool writeRowsCsv(const std::string& path, const std::vector<Row>& rows, std::st
   for (const Row& r : rows) {
     const Setting& s = r.setting;
     std::fprintf(f.get(),
-                 "%s,%s,%s,%s,%s,%s,%d,%.4g,%g,%u,%u,%u,%g,%u,%d,%zu,%.4g,"
+                 "%s,%s,%s,%s,%s,%s,%d,%.4g,%g,%u,%u,%u,%g,%u,%u,%d,%zu,%.4g,"
                  "%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,"
                  "%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%u,%.5g,%.5g,%d,%u,%.4g\n",
                  csvText(s.sweep).c_str(), csvText(s.label).c_str(), csvText(r.take).c_str(), solverName(s.solver),
                  responseName(s.contact_response), csvText(s.backend).c_str(), s.is_default ? 1 : 0, r.rate_hz, s.substep_hz,
-                 s.iterations, s.ring_points, s.continuous_collision, s.strain_limit, r.particles, r.repeats,
+                 s.iterations, s.ring_points, s.continuous_collision, s.strain_limit, s.strain_limit_passes,
+                 r.particles, r.repeats,
                  r.timed_frames,
                  r.substeps_per_frame, r.frame.median, r.frame.p90, r.skeleton.median, r.skeleton.p90, r.body.median,
                  r.body.p90, r.proxies.median, r.proxies.p90, r.cloth.median, r.cloth.p90, r.integrate.median,

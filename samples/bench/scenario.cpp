@@ -77,9 +77,9 @@ bool loadTake(const std::string& path, uint32_t frames, uint32_t stride, Take& o
 
 std::string Setting::key() const {
   char buf[256];
-  std::snprintf(buf, sizeof buf, "s%d hz%g it%u K%u rule%d resp%d ccd%u sl%g n%u %s", solver, substep_hz, iterations,
-                ring_points, proxy_rule, contact_response, continuous_collision, strain_limit, particles,
-                backend.c_str());
+  std::snprintf(buf, sizeof buf, "s%d hz%g it%u K%u rule%d resp%d ccd%u sl%g x%u n%u %s", solver, substep_hz,
+                iterations, ring_points, proxy_rule, contact_response, continuous_collision, strain_limit,
+                strain_limit_passes, particles, backend.c_str());
   return buf;
 }
 
@@ -158,6 +158,7 @@ bool runDrape(const Take& take, const Setting& s, const RunOptions& o, RunResult
   cloth.contact_response = s.contact_response;
   cloth.continuous_collision = s.continuous_collision;
   cloth.strain_limit = s.strain_limit;
+  cloth.strain_limit_passes = s.strain_limit_passes;
   // Room for a whole frame of the take at this rate (the reference runs thousands of Hz).
   const auto per_frame = static_cast<uint32_t>(std::ceil(s.substep_hz / take.rate_hz));
   cloth.max_substeps = std::max(cloth.max_substeps, std::min<uint32_t>(1000, 2 * per_frame));

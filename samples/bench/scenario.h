@@ -39,6 +39,7 @@ struct Setting {
   int32_t contact_response = DRAPE_CONTACT_EXACT;
   uint32_t continuous_collision = 1;
   float strain_limit = 0.1f;  // drape_cloth_params.strain_limit (0 = off); XPBD only
+  uint32_t strain_limit_passes = 2;  // drape_cloth_params.strain_limit_passes, [1, 16]
   uint32_t particles = 2000;
   std::string backend = "cpu";
   bool is_default = false;

@@ -69,14 +69,27 @@ std::vector<Sweep> makeSweeps(bool quick, bool with_opencl) {
   }
   {
     // drape_cloth_params.strain_limit: structural edges held to rest x (1 + limit) at the end of
-    // each step (docs/cloth-solver.md).
-    Sweep sw{"strain_limit", "Strain limit at the end of each step (structural edges, over rest)", {}};
-    const std::vector<float> limits = quick ? std::vector<float>{0.0f, 0.1f} : std::vector<float>{0.0f, 0.05f, 0.1f, 0.2f};
-    for (float l : limits) {
-      char label[32];
-      std::snprintf(label, sizeof label, l > 0.0f ? "%g %%" : "off", 100.0 * l);
+    // each step (docs/cloth-solver.md), in strain_limit_passes Gauss-Seidel passes (2 unless the
+    // label says; docs/garments.md, "More strain-limit passes").
+    Sweep sw{"strain_limit", "Strain limit at the end of each step (structural edges, over rest) and its passes", {}};
+    struct Point {
+      float limit;
+      uint32_t passes;
+    };
+    const std::vector<Point> points =
+        quick ? std::vector<Point>{{0.0f, 2}, {0.1f, 2}, {0.05f, 8}}
+              : std::vector<Point>{{0.0f, 2}, {0.05f, 2}, {0.1f, 2}, {0.2f, 2}, {0.05f, 8}, {0.05f, 16}};
+    for (const Point& pt : points) {
+      char label[48];
+      if (!(pt.limit > 0.0f))
+        std::snprintf(label, sizeof label, "off");
+      else if (pt.passes == Setting{}.strain_limit_passes)
+        std::snprintf(label, sizeof label, "%g %%", 100.0 * pt.limit);
+      else
+        std::snprintf(label, sizeof label, "%g %% x %u passes", 100.0 * pt.limit, pt.passes);
       Setting s = base("strain_limit", label);
-      s.strain_limit = l;
+      s.strain_limit = pt.limit;
+      s.strain_limit_passes = pt.passes;
       sw.settings.push_back(s);
     }
     out.push_back(sw);

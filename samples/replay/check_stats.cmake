@@ -3,6 +3,7 @@
 #   cmake -DEXE=... -DOUT_DIR=... -DARGS="a|b|c" -DEXPECT_FRAMES=N -DEXPECT_OBJ=N
 #         [-DEXPECT_GARMENT=template|obj|none -DEXPECT_GARMENT_OBJ=N -DEXPECT_MEASURED=N]
 #         [-DEXPECT_SUBSTEP_HZ=N (garment.substep_hz)] [-DEXPECT_UNDER=kind (--under; garment.under)]
+#         [-DEXPECT_STRAIN_LIMIT_PASSES=N (garment.strain_limit_passes)]
 #         [-DEXPECT_FORMAT=kinect_csv] [-DEXPECT_BACKEND=cpu|opencl] [-DVOLUME_MIN_L=x -DVOLUME_MAX_L=y] [-DPYTHON=python3]
 #         [-DEXPECT_RENDERED=N -DEXPECT_PNG_SIZE=WxH -DEXPECT_SHEET=ON|OFF -DEXPECT_GIF=ON|OFF]
 #         -P check_stats.cmake
@@ -240,6 +241,10 @@ else()
   if(DEFINED EXPECT_SUBSTEP_HZ)
     json_get(_ghz garment substep_hz)
     expect_equal("garment.substep_hz" "${_ghz}" "${EXPECT_SUBSTEP_HZ}")
+  endif()
+  if(DEFINED EXPECT_STRAIN_LIMIT_PASSES)
+    json_get(_gslp garment strain_limit_passes)
+    expect_equal("garment.strain_limit_passes" "${_gslp}" "${EXPECT_STRAIN_LIMIT_PASSES}")
   endif()
   if(_gmeasured GREATER 0)
     foreach(path IN LISTS _garment_measured)

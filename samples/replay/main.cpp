@@ -212,6 +212,7 @@ int run(int argc, char** argv) {
     if (opt.iterations != 0) cloth.iterations = opt.iterations;
     if (opt.strain_limit >= 0.0) cloth.strain_limit = static_cast<float>(opt.strain_limit);
     if (opt.collision_stride >= 0) cloth.collision_stride = static_cast<uint32_t>(opt.collision_stride);
+    if (opt.strain_limit_passes > 0) cloth.strain_limit_passes = static_cast<uint32_t>(opt.strain_limit_passes);
     // A frame a little longer than 1/30 s must not hit the per-step cap (which would lengthen
     // every substep instead of adding some).
     const uint32_t per_frame = static_cast<uint32_t>(std::ceil(cloth.substep_hz / 30.0f));
@@ -363,6 +364,7 @@ int run(int argc, char** argv) {
     st.iterations = actual.iterations;
     st.strain_limit = actual.strain_limit;
     st.collision_stride = actual.collision_stride;
+    st.strain_limit_passes = actual.strain_limit_passes;
     st.particles = garment_mesh.vertices;
     st.garment_triangles = garment_mesh.index_count / 3;
     st.attached = gs.attached;

@@ -39,6 +39,7 @@ struct Options {
   uint32_t substeps = 0;           // per 1/30 s frame; 0: the library default (or 2880 Hz for massspring)
   uint32_t iterations = 0;         // XPBD passes per substep, [1, 64]; 0: the library default (1)
   double strain_limit = -1.0;      // XPBD strain limit, [0, 10]; < 0: the library default (0.1)
+  int32_t strain_limit_passes = 0; // XPBD strain-limit passes, [1, 16]; 0: the library default (2)
   int32_t collision_stride = -1;   // XPBD collision every N substeps, [0, 8]; < 0: the library default (0: by resolution)
   uint32_t measure_every = 1;      // drape_garment_measure every N stepped frames; 0: never
   bool measure_given = false;

@@ -189,10 +189,12 @@ std::string statsJson(const ReplayStats& s) {
     if (s.solver == DRAPE_SOLVER_MASS_SPRING) {
       w.key("iterations").null();
       w.key("strain_limit").null();
+      w.key("strain_limit_passes").null();
       w.key("collision_stride").null();
     } else {
       w.key("iterations").value(s.iterations);
       w.key("strain_limit").value(s.strain_limit);
+      w.key("strain_limit_passes").value(static_cast<int64_t>(s.strain_limit_passes));
       w.key("collision_stride").value(s.collision_stride);
     }
   } else {
@@ -202,6 +204,7 @@ std::string statsJson(const ReplayStats& s) {
     w.key("substep_hz").null();
     w.key("iterations").null();
     w.key("strain_limit").null();
+    w.key("strain_limit_passes").null();
     w.key("collision_stride").null();
   }
   w.key("triangles").value(s.garment_triangles);

@@ -69,6 +69,7 @@ struct ReplayStats {
   double substep_hz = 0.0;         // drape_garment_get_params after adding
   uint32_t iterations = 0;         // the same: XPBD passes per substep
   double strain_limit = 0.0;       // the same: XPBD strain limit (0 = off)
+  uint32_t strain_limit_passes = 0; // the same: its Gauss-Seidel passes
   uint32_t collision_stride = 0;   // the same: XPBD collision every N substeps (0 = by resolution)
   uint32_t particles = 0;          // garment vertex count
   uint32_t garment_triangles = 0;

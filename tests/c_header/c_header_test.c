@@ -113,7 +113,8 @@ int main(void) {
     CHECK(first.arms_clear_torso == 0x5A5A5A5A);
   }
   CHECK(offsetof(drape_cloth_params, collision_stride) == DRAPE_CLOTH_PARAMS_SIZE_V1);
-  CHECK(sizeof(drape_cloth_params) == DRAPE_CLOTH_PARAMS_SIZE_V1 + 4);
+  CHECK(offsetof(drape_cloth_params, strain_limit_passes) == DRAPE_CLOTH_PARAMS_SIZE_V2);
+  CHECK(sizeof(drape_cloth_params) == DRAPE_CLOTH_PARAMS_SIZE_V2 + 4);
   CHECK_OK(drape_context_create(&desc, &ctx));
   if (ctx == NULL) {
     fprintf(stderr, "no context: giving up\n");

@@ -334,8 +334,13 @@ struct Machine {
       c.spring_bend = in.inRange(0.0f, 1e6f);
       c.spring_damping = in.inRange(0.0f, 1e6f);
     }
-    if (mode & 32) c.strain_limit = in.inRange(-1.0f, 12.0f);  // outside [0, 10] is refused
-    if (mode & 64) c.struct_size = in.u8();  // 128 .. 131: the first layout, collision_stride not read
+    if (mode & 32) {
+      c.strain_limit = in.inRange(-1.0f, 12.0f);  // outside [0, 10] is refused
+      c.strain_limit_passes = in.u8() % 18;       // 0 and 17 are refused
+    }
+    // 128 .. 131: the first layout, collision_stride not read; 132 .. 135: the second,
+    // strain_limit_passes not read
+    if (mode & 64) c.struct_size = in.u8();
     if (mode & 128) c.collision_stride = in.u8() % 10;  // 9 is refused
   }
 

@@ -72,6 +72,7 @@ TEST(CApiGarments, InitFunctionsFillDefaults) {
   EXPECT_EQ(c.contact_response, DRAPE_CONTACT_EXACT);
   EXPECT_EQ(c.continuous_collision, 1u);
   EXPECT_EQ(c.collision_stride, 0u);  // by the garment's resolution
+  EXPECT_EQ(c.strain_limit_passes, 2u);
   drape_mesh_fit f;
   ASSERT_OK(drape_mesh_fit_init(&f));
   EXPECT_FLOAT_EQ(f.source_height_m, 1.60f);
@@ -203,7 +204,7 @@ TEST(CApiGarments, ClothParamsOfTheFirstStructVersionAreStillRead) {
   drape_cloth_params full;
   full.struct_size = sizeof(full);
   ASSERT_OK(drape_garment_get_params(g, &full));
-  EXPECT_EQ(full.struct_size, 132u);
+  EXPECT_EQ(full.struct_size, 136u);
   expectFirstStructVersionFilled(full, DRAPE_CLOTH_PARAMS_SIZE_V1, "drape_cloth_params.struct_size",
                                  [&](drape_cloth_params* out) { return drape_garment_get_params(g, out); });
   // Set: an explicit stride, then the first layout with garbage where collision_stride would be.
@@ -339,6 +340,8 @@ TEST(CApiGarments, BadParametersAreRejectedAndChangeNothing) {
       {"collision_stride 9", [](drape_cloth_params& p) { p.collision_stride = 9; }, DRAPE_ERROR_OUT_OF_RANGE},
       {"collision_stride 2^32 - 1", [](drape_cloth_params& p) { p.collision_stride = 0xFFFFFFFFu; },
        DRAPE_ERROR_OUT_OF_RANGE},
+      {"strain_limit_passes 0", [](drape_cloth_params& p) { p.strain_limit_passes = 0; }, DRAPE_ERROR_OUT_OF_RANGE},
+      {"strain_limit_passes 17", [](drape_cloth_params& p) { p.strain_limit_passes = 17; }, DRAPE_ERROR_OUT_OF_RANGE},
       {"struct_size", [](drape_cloth_params& p) { p.struct_size = 8; }, DRAPE_ERROR_INVALID_ARGUMENT},
       {"struct_size of the first version minus 4",
        [](drape_cloth_params& p) { p.struct_size = DRAPE_CLOTH_PARAMS_SIZE_V1 - 4; }, DRAPE_ERROR_INVALID_ARGUMENT},

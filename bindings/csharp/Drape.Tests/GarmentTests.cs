@@ -107,7 +107,7 @@ namespace Drape.Tests
             Assert.Equal(GarmentKind.Skirt, GarmentTemplate.CreateDefault(GarmentKind.Skirt).Kind);
 
             ClothParams c = ClothParams.CreateDefault();
-            Assert.Equal(132u, c.StructSize);
+            Assert.Equal(136u, c.StructSize);
             Assert.Equal(300f, c.SubstepHz);
             Assert.Equal(1u, c.Iterations);
             Assert.Equal(200u, c.MaxSubsteps);
@@ -117,6 +117,7 @@ namespace Drape.Tests
             Assert.Equal(0.004f, c.CollisionMarginM, 1e-6f);
             Assert.Equal(0.1f, c.StrainLimit, 1e-6f);
             Assert.Equal(0u, c.CollisionStride);
+            Assert.Equal(2u, c.StrainLimitPasses);
 
             MeshFit f = MeshFit.CreateDefault();
             Assert.Equal(48u, f.StructSize);
@@ -385,6 +386,8 @@ namespace Drape.Tests
             p.ContactResponse = ContactResponse.Radial;
             p.IsContinuousCollision = false;
             p.BlendInS = 0f;
+            p.StrainLimit = 0.05f;
+            p.StrainLimitPasses = 8;
             g.Params = p;
             ClothParams back = g.Params;
             Assert.Equal(Bytes(p), Bytes(back));
@@ -404,6 +407,11 @@ namespace Drape.Tests
             e = Assert.Throws<DrapeException>(() => g.SetParams(bad));
             Assert.Equal(ResultCode.OutOfRange, e.Code);
             Assert.Contains("substep_hz", e.NativeMessage);
+            bad = back;
+            bad.StrainLimitPasses = 17;
+            e = Assert.Throws<DrapeException>(() => g.SetParams(bad));
+            Assert.Equal(ResultCode.OutOfRange, e.Code);
+            Assert.Contains("strain_limit_passes", e.NativeMessage);
             Assert.Equal(ResultCode.InvalidArgument, Assert.Throws<DrapeException>(() => g.Params = default).Code);
             Assert.Equal(Bytes(back), Bytes(g.Params));
 

@@ -177,7 +177,7 @@ namespace Drape.Tests
             ("OutsideFraction", 32), ("Reserved", 36));
 
         // Garments: sizes asserted at the end of native/src/capi/capi_garments.cpp (but drape_cloth_params,
-        // 132 bytes: C layout rules, checked with offsetof when this table was written).
+        // 136 bytes: C layout rules, checked with offsetof when this table was written).
         [Fact]
         public void GarmentDesc_Is24() => AssertLayout<GarmentDesc>(24,
             ("StructSize", 0), ("Solver", 4), ("AreaDensity", 8), ("MaxTethers", 12), ("DressTimeS", 16), ("Cut", 20));
@@ -187,14 +187,14 @@ namespace Drape.Tests
             ("StructSize", 0), ("Kind", 4), ("Particles", 8), ("EaseM", 12), ("LengthScale", 16), ("Reserved", 20));
 
         [Fact]
-        public void ClothParams_Is132() => AssertLayout<ClothParams>(132,
+        public void ClothParams_Is136() => AssertLayout<ClothParams>(136,
             ("StructSize", 0), ("SubstepHz", 4), ("MaxSubsteps", 8), ("MaxStepS", 12), ("Gravity", 16), ("Wind", 28),
             ("Drag", 40), ("Damping", 44), ("MaxSpeed", 48), ("StretchCompliance", 52), ("ShearCompliance", 56),
             ("BendCompliance", 60), ("TetherCompliance", 64), ("TetherScale", 68), ("StaticFriction", 72),
             ("KineticFriction", 76), ("CollisionMarginM", 80), ("ContactResponse", 84), ("ContinuousCollision", 88),
             ("LinearInertia", 92), ("AngularInertia", 96), ("BlendInS", 100), ("SpringStretch", 104),
             ("SpringShear", 108), ("SpringBend", 112), ("SpringDamping", 116), ("Iterations", 120), ("StrainLimit", 124),
-            ("CollisionStride", 128));
+            ("CollisionStride", 128), ("StrainLimitPasses", 132));
 
         [Fact]
         public void MeshFit_Is48() => AssertLayout<MeshFit>(48,

@@ -87,6 +87,7 @@ drape_result toSimParams(const char* fn, const drape_cloth_params& c, drape::Gar
   k.range(w, "iterations", static_cast<float>(c.iterations), 1.0f, 64.0f);
   k.range(w, "strain_limit", c.strain_limit, 0.0f, 10.0f);
   k.range(w, "collision_stride", static_cast<float>(c.collision_stride), 0.0f, 8.0f);
+  k.range(w, "strain_limit_passes", static_cast<float>(c.strain_limit_passes), 1.0f, 16.0f);
   if (drape_result r = k.done(fn)) return r;
   drape::GarmentSimParams p;
   p.substep_hz = c.substep_hz;
@@ -118,6 +119,7 @@ drape_result toSimParams(const char* fn, const drape_cloth_params& c, drape::Gar
   p.xpbd.iterations = static_cast<int>(c.iterations);
   p.xpbd.strain_limit = c.strain_limit;
   p.xpbd.collision_stride = static_cast<int>(c.collision_stride);
+  p.xpbd.strain_limit_passes = static_cast<int>(c.strain_limit_passes);
   const std::string e = drape::validate(p);
   if (!e.empty()) return fail(DRAPE_ERROR_OUT_OF_RANGE, std::string(fn) + ": cloth params: " + e);
   out = p;
@@ -156,17 +158,21 @@ void fromSimParams(const drape::GarmentSimParams& p, drape_cloth_params& c) {
   c.iterations = static_cast<uint32_t>(p.xpbd.iterations);
   c.strain_limit = p.xpbd.strain_limit;
   c.collision_stride = static_cast<uint32_t>(p.xpbd.collision_stride);
+  c.strain_limit_passes = static_cast<uint32_t>(p.xpbd.strain_limit_passes);
 }
 
 // A caller's drape_cloth_params, of the first layout (struct_size DRAPE_CLOTH_PARAMS_SIZE_V1,
-// without collision_stride) or the current one: the fields its struct_size covers whole, the
-// later one's default. Nothing past the caller's struct_size is read.
+// without collision_stride), the second (V2, without strain_limit_passes) or the current one: the
+// fields its struct_size covers whole, the later ones' defaults. Nothing past the caller's
+// struct_size is read.
 drape_result readClothParams(const drape_cloth_params& in, drape_cloth_params& out) {
   if (drape_result r = checkStructSize(in.struct_size, DRAPE_CLOTH_PARAMS_SIZE_V1, "drape_cloth_params")) return r;
   drape_cloth_params_init(&out);
   std::memcpy(&out, &in, DRAPE_CLOTH_PARAMS_SIZE_V1);
   if (in.struct_size >= offsetof(drape_cloth_params, collision_stride) + sizeof(out.collision_stride))
     out.collision_stride = in.collision_stride;
+  if (in.struct_size >= offsetof(drape_cloth_params, strain_limit_passes) + sizeof(out.strain_limit_passes))
+    out.strain_limit_passes = in.strain_limit_passes;
   out.struct_size = sizeof(drape_cloth_params);
   return DRAPE_OK;
 }
@@ -672,6 +678,8 @@ static_assert(sizeof(drape_garment_stats) == 104, "drape_garment_stats layout");
 static_assert(offsetof(drape_garment_stats, device_upload_ms) == 72, "drape_garment_stats: the first version's 72 bytes moved");
 static_assert(sizeof(drape_garment_accuracy) == 40, "drape_garment_accuracy layout");
 static_assert(offsetof(drape_garment_accuracy, openings) == 32, "drape_garment_accuracy: the first version's 32 bytes moved");
-static_assert(sizeof(drape_cloth_params) == 132, "drape_cloth_params layout");
+static_assert(sizeof(drape_cloth_params) == 136, "drape_cloth_params layout");
+static_assert(offsetof(drape_cloth_params, strain_limit_passes) == DRAPE_CLOTH_PARAMS_SIZE_V2,
+              "drape_cloth_params: the second version's 132 bytes moved");
 static_assert(offsetof(drape_cloth_params, collision_stride) == DRAPE_CLOTH_PARAMS_SIZE_V1,
               "drape_cloth_params: the first version's 128 bytes moved");
