@@ -195,6 +195,37 @@ namespace Drape.Tests
         }
 
         [Fact]
+        public void DrapeDresser_LessStretch_ReachesBothGarmentsParams()
+        {
+            ClothParams ParamsOf(bool less, bool under)
+            {
+                var go = new GameObject("person");
+                var source = go.AddComponent<RecordingJointSourceBehaviour>();
+                Set(source, "recording", new TextAsset(SyntheticKinect2.Csv(30)));
+                var dresser = go.AddComponent<DrapeDresser>();
+                Set(dresser, "particles", 300);
+                Set(dresser, "garmentMesh", go.AddComponent<MeshFilter>());
+                Set(dresser, "underMesh", new GameObject("trousers").AddComponent<MeshFilter>());
+                if (less) Set(dresser, "lessStretch", true);
+                Message(dresser, "OnEnable");
+                Assert.True(dresser.enabled, string.Join("\n", UnityEngine.Debug.StandInLog));
+                Time.deltaTime = 1f / 30f;
+                for (int i = 0; i < 3; ++i) Message(dresser, "Update");
+                ClothParams p = under ? dresser.UnderGarment!.Params : dresser.Garment!.Params;
+                Message(dresser, "OnDisable");
+                return p;
+            }
+            foreach (bool under in new[] { false, true })
+            {
+                ClothParams byDefault = ParamsOf(false, under), less = ParamsOf(true, under);
+                Assert.Equal(2u, byDefault.StrainLimitPasses);
+                Assert.Equal(0.1f, byDefault.StrainLimit, 1e-6f);
+                Assert.Equal(8u, less.StrainLimitPasses);
+                Assert.Equal(0.05f, less.StrainLimit, 1e-6f);
+            }
+        }
+
+        [Fact]
         public void DrapeDresser_ArmsClearTorso_ReachesTheContext()
         {
             Vector3[] BodyAfterUpdates(bool armsClear)

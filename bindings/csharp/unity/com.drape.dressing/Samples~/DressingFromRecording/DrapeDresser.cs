@@ -33,6 +33,8 @@ namespace Drape.Samples
         [SerializeField] private MeshFilter garmentMesh = null;
         [Tooltip("Normals from Drape (true) or Mesh.RecalculateNormals (false).")]
         [SerializeField] private bool drapeNormals = true;
+        [Tooltip("Less stretch: the strain limit at 5 % in 8 passes instead of 10 % in 2 (ClothParams.StrainLimit, StrainLimitPasses) for both garments: T-shirts, skirts, dresses and trousers stretch 13-18 % less at the P99 for about 6 % more cloth time; a long sleeve on a waving arm can come off with it (docs/garments.md, \"More strain-limit passes\").")]
+        [SerializeField] private bool lessStretch = false;
 
         [Header("Garment under it (optional)")]
         [Tooltip("Receives the mesh of a second garment worn under the first (its sharedMesh is replaced); leave empty for one garment. The first garment then lies on it (layers: docs/garments.md, \"Layered garments\").")]
@@ -97,7 +99,13 @@ namespace Drape.Samples
                 if (particles > 0) tmpl.Particles = (uint)particles;
                 GarmentDesc desc = GarmentDesc.CreateDefault();
                 desc.Cut = cut;
-                _garment = _loop.Context.AddGarment(tmpl, desc);
+                ClothParams cloth = ClothParams.CreateDefault();
+                if (lessStretch)
+                {
+                    cloth.StrainLimit = 0.05f;
+                    cloth.StrainLimitPasses = 8;
+                }
+                _garment = _loop.Context.AddGarment(tmpl, desc, cloth);
 
                 _garmentPositions = new Vector3[_garment.VertexCount];
                 _garmentNormals = new Vector3[_garment.VertexCount];
@@ -110,7 +118,7 @@ namespace Drape.Samples
                 {
                     GarmentTemplate underTmpl = GarmentTemplate.CreateDefault(underGarment);
                     if (particles > 0) underTmpl.Particles = (uint)particles;
-                    _under = _loop.Context.AddGarment(underTmpl, desc);
+                    _under = _loop.Context.AddGarment(underTmpl, desc, cloth);
                     _under.Layer = 1;     // next to the body
                     _garment.Layer = 2;   // lies on it
                     _underPositions = new Vector3[_under.VertexCount];
