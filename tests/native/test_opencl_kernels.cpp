@@ -345,8 +345,10 @@ constexpr float kStrainTestStretchCompliance = 1e-2f;
 // static w_a + w_b, the CPU refreshes its inv_w) with every kind compliant and each kind's
 // compliance different, so a kind given another's alpha~ fails the first frames' 1e-5 bound.
 // A third time with the strain limit on (XpbdParams::strain_limit, GarmentSimParams' 0.1, two
-// passes in each step's last substep): the same bounds.
-void frameMatchesXpbdStep(const std::shared_ptr<ClRuntime>& rt, bool varying, float strain_limit = 0.0f) {
+// passes in each step's last substep), and a fourth at 5 % in 8 passes (strain_limit_passes,
+// docs/garments.md "More strain-limit passes"): the same bounds.
+void frameMatchesXpbdStep(const std::shared_ptr<ClRuntime>& rt, bool varying, float strain_limit = 0.0f,
+                          int strain_limit_passes = 2) {
   const GarmentTopology t = flatSquare(24, 24);
   std::string err;
   XpbdParams p;
@@ -360,6 +362,7 @@ void frameMatchesXpbdStep(const std::shared_ptr<ClRuntime>& rt, bool varying, fl
     p.tether_compliance = 1e-6f;
   }
   p.strain_limit = strain_limit;
+  p.strain_limit_passes = strain_limit_passes;
   // The CPU's own divergence: two runs nudged by 1 um (along x, along z) at the start; the
   // larger of their distances from the unnudged run is the reference (one nudge alone is a
   // noisy estimate of how fast this scene amplifies rounding).
@@ -421,6 +424,11 @@ TEST(OpenClKernels, FrameMatchesXpbdStepWithAFrameTimeThatVaries) {
 TEST(OpenClKernels, FrameMatchesXpbdStepWithTheStrainLimit) {
   DRAPE_REQUIRE_OPENCL(rt);
   frameMatchesXpbdStep(rt, false, GarmentSimParams{}.xpbd.strain_limit);
+}
+
+TEST(OpenClKernels, FrameMatchesXpbdStepWithEightStrainLimitPasses) {
+  DRAPE_REQUIRE_OPENCL(rt);
+  frameMatchesXpbdStep(rt, false, 0.05f, 8);
 }
 
 // The largest strain (|d| / rest - 1) over the structural (stretch) edges, 0 when none is
