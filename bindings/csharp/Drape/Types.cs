@@ -659,7 +659,7 @@ namespace Drape
         /// <summary>strain_limit_passes: XPBD, Gauss-Seidel passes of the strain limit at the end of
         /// each step, [1, 16]; default 2. Each pass costs about 4 us at 2 000 particles; with a
         /// tighter <see cref="StrainLimit"/> more passes stretch less (0.05 with 8 passes: the P99
-        /// stretch of T-shirts, skirts, dresses and trousers 13-18 % lower on the shared takes for
+        /// stretch of T-shirts, skirts, dresses and trousers 15-18 % lower on the shared takes for
         /// about 6 % more frame time; docs/garments.md, "More strain-limit passes"). Added after
         /// <see cref="CollisionStride"/> (132 to 136 bytes); the library still accepts the older
         /// layouts and gives them the default.</summary>

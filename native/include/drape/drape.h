@@ -565,7 +565,7 @@ typedef struct drape_cloth_params {
                                   step, [1, 16]; 2. Each pass over the structural edges costs about
                                   4 us at 2 000 particles here; with a tighter strain_limit, more
                                   passes buy less stretch: 8 passes at 0.05 lowered the P99
-                                  stretch of 4 of the 5 templates by 13-18 % over the shared takes,
+                                  stretch of 4 of the 5 templates by 15-18 % over the shared takes,
                                   for about 6 % more frame time, but took a long sleeve off a waving
                                   arm (docs/garments.md, "More strain-limit passes"). Ignored when
                                   strain_limit is 0 and by the mass-spring solver */

@@ -33,7 +33,7 @@ namespace Drape.Samples
         [SerializeField] private MeshFilter garmentMesh = null;
         [Tooltip("Normals from Drape (true) or Mesh.RecalculateNormals (false).")]
         [SerializeField] private bool drapeNormals = true;
-        [Tooltip("Less stretch: the strain limit at 5 % in 8 passes instead of 10 % in 2 (ClothParams.StrainLimit, StrainLimitPasses) for both garments: T-shirts, skirts, dresses and trousers stretch 13-18 % less at the P99 for about 6 % more cloth time; a long sleeve on a waving arm can come off with it (docs/garments.md, \"More strain-limit passes\").")]
+        [Tooltip("Less stretch: the strain limit at 5 % in 8 passes instead of 10 % in 2 (ClothParams.StrainLimit, StrainLimitPasses) for both garments: T-shirts, skirts, dresses and trousers stretch 15-18 % less at the P99 for about 6 % more cloth time; a long sleeve on a waving arm can come off with it (docs/garments.md, \"More strain-limit passes\").")]
         [SerializeField] private bool lessStretch = false;
 
         [Header("Garment under it (optional)")]
