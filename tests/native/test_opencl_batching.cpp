@@ -330,6 +330,42 @@ TEST(OpenClBatching, LargeGarmentsMatchOneByOneBitForBit) {
   expectSameRuns(runTake({&c, &d}, take, true), separate);
 }
 
+// Garments of one context with strain-limit passes of their own (drape_cloth_params.
+// strain_limit_passes 8, 2 and 5 at a 5 % limit): batched, the per-phase launches run the most
+// passes any garment asks for and the kernels stop each garment at its own (cl_phase_launch.cpp),
+// the small garment's frame launch its own: bit for bit as one by one. And the passes act on the
+// device: the same garments all at 2 passes end elsewhere.
+TEST(OpenClBatching, LargeGarmentsWithTheirOwnStrainLimitPassesMatchOneByOne) {
+  DRAPE_LOAD_TAKE(take, 4);
+  const std::vector<uint32_t> sizes = {kLarge, 600, kLarge};
+  auto withPasses = [&](std::vector<uint32_t> passes) {
+    World w = makeWorld(sizes, DRAPE_BACKEND_OPENCL);
+    for (size_t k = 0; k < w.garments.size(); ++k) {
+      drape_cloth_params p;
+      EXPECT_EQ(drape_cloth_params_init(&p), DRAPE_OK);
+      p.strain_limit = 0.05f;
+      p.strain_limit_passes = passes[k];
+      EXPECT_EQ(drape_garment_set_params(w.garments[k], &p), DRAPE_OK) << lastError();
+    }
+    return w;
+  };
+  World one = withPasses({8, 2, 5});
+  DRAPE_REQUIRE_DEVICE_WORLD(one);
+  expectLarge(one, 0);
+  expectLarge(one, 2);
+  std::vector<std::vector<float>> by_one;
+  {
+    Batching off(false);
+    by_one = runTake({&one}, take, false);
+  }
+  World batched = withPasses({8, 2, 5});
+  const auto together = runTake({&batched}, take, false);
+  expectSameRuns(together, by_one);
+  World two = withPasses({2, 2, 2});
+  const auto all_two = runTake({&two}, take, false);
+  EXPECT_FALSE(sameBits(all_two.back(), together.back()));
+}
+
 // Launches per frame on the per-phase path (~25 per substep) do not grow with the number of large
 // garments: 1 or 2 large garments batched cost the launches of one alone; a small one adds its
 // batch's frame launch; one by one, each large garment pays its own.
