@@ -14,6 +14,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -307,14 +308,11 @@ void expectLarge(const World& w, size_t garment) {
   EXPECT_GT(n, 4096u) << "not on the per-phase path";
 }
 
-// Two large garments and a small one in one context: bit for bit as one by one (one frame launch
-// for the small one, each phase once for both large ones). Two contexts (large; small) through
-// drape_step_contexts: as stepping each (each alone there).
-TEST(OpenClBatching, LargeGarmentsMatchOneByOneBitForBit) {
-  DRAPE_LOAD_TAKE(take, 4);
-  const std::vector<uint32_t> sizes = {kLarge, 600, kLarge};
-  World one = makeWorld(sizes, DRAPE_BACKEND_OPENCL);
-  DRAPE_REQUIRE_DEVICE_WORLD(one);
+// Steps `one` (from `make`, on the device: large garments first and last, a small one between)
+// through the take with batching off (each garment its own launches), then a second world from
+// `make` with it on; expects the same bits and returns the batched run.
+std::vector<std::vector<float>> expectLargeBatchedAsOneByOne(World& one, const std::function<World()>& make,
+                                                             const Take& take) {
   expectLarge(one, 0);
   expectLarge(one, 2);
   std::vector<std::vector<float>> by_one;
@@ -322,8 +320,22 @@ TEST(OpenClBatching, LargeGarmentsMatchOneByOneBitForBit) {
     Batching off(false);
     by_one = runTake({&one}, take, false);
   }
-  World batched = makeWorld(sizes, DRAPE_BACKEND_OPENCL);
-  expectSameRuns(runTake({&batched}, take, false), by_one);
+  World batched = make();
+  std::vector<std::vector<float>> together = runTake({&batched}, take, false);
+  expectSameRuns(together, by_one);
+  return together;
+}
+
+// Two large garments and a small one in one context: bit for bit as one by one (one frame launch
+// for the small one, each phase once for both large ones). Two contexts (large; small) through
+// drape_step_contexts: as stepping each (each alone there).
+TEST(OpenClBatching, LargeGarmentsMatchOneByOneBitForBit) {
+  DRAPE_LOAD_TAKE(take, 4);
+  const std::vector<uint32_t> sizes = {kLarge, 600, kLarge};
+  const auto make = [&] { return makeWorld(sizes, DRAPE_BACKEND_OPENCL); };
+  World one = make();
+  DRAPE_REQUIRE_DEVICE_WORLD(one);
+  expectLargeBatchedAsOneByOne(one, make, take);
   World a = makeWorld({kLarge}, DRAPE_BACKEND_OPENCL), b = makeWorld({600}, DRAPE_BACKEND_OPENCL);
   const auto separate = runTake({&a, &b}, take, false);
   World c = makeWorld({kLarge}, DRAPE_BACKEND_OPENCL), d = makeWorld({600}, DRAPE_BACKEND_OPENCL);
@@ -349,18 +361,10 @@ TEST(OpenClBatching, LargeGarmentsWithTheirOwnStrainLimitPassesMatchOneByOne) {
     }
     return w;
   };
-  World one = withPasses({8, 2, 5});
+  const auto make = [&] { return withPasses({8, 2, 5}); };
+  World one = make();
   DRAPE_REQUIRE_DEVICE_WORLD(one);
-  expectLarge(one, 0);
-  expectLarge(one, 2);
-  std::vector<std::vector<float>> by_one;
-  {
-    Batching off(false);
-    by_one = runTake({&one}, take, false);
-  }
-  World batched = withPasses({8, 2, 5});
-  const auto together = runTake({&batched}, take, false);
-  expectSameRuns(together, by_one);
+  const auto together = expectLargeBatchedAsOneByOne(one, make, take);
   World two = withPasses({2, 2, 2});
   const auto all_two = runTake({&two}, take, false);
   EXPECT_FALSE(sameBits(all_two.back(), together.back()));

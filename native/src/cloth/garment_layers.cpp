@@ -30,7 +30,7 @@ void ClothShell::findHosts(const Eigen::Vector4f* positions, size_t count, const
       const Eigen::Vector4f& sk = spheres_[k];
       const Vec3 d = x - sk.head<3>();
       if (!(d.squaredNorm() <= sk.w())) continue;
-      const float q2 = (units_[k] * d).squaredNorm();
+      const float q2 = (ellipsoids[k].to_unit * d).squaredNorm();
       if (q2 < best) {
         best = q2;
         host_[i] = static_cast<int32_t>(k);
@@ -42,10 +42,6 @@ void ClothShell::findHosts(const Eigen::Vector4f* positions, size_t count, const
 void ClothShell::measure(const Eigen::Vector4f* positions, size_t count, const std::vector<Ellipsoid>& ellipsoids) {
   offsets_.assign(ellipsoids.size(), 0.0f);
   if (positions == nullptr || count == 0 || ellipsoids.empty()) return;
-  // Each ellipsoid's world -> unit map, once.
-  units_.resize(ellipsoids.size());
-  for (size_t k = 0; k < ellipsoids.size(); ++k)
-    units_[k] = ellipsoids[k].radii.cwiseInverse().asDiagonal() * ellipsoids[k].rotation.transpose();
   if (hosts_round_ < 0 || host_.size() != count || hosts_ellipsoids_ != ellipsoids.size()) {
     findHosts(positions, count, ellipsoids, -1);
     hosts_round_ = 0;
@@ -63,7 +59,7 @@ void ClothShell::measure(const Eigen::Vector4f* positions, size_t count, const s
     const Vec3 x = positions[i].head<3>();
     if (k < 0 || !isFinite(x)) continue;
     const Ellipsoid& e = ellipsoids[static_cast<size_t>(k)];
-    const Mat3& to_unit = units_[static_cast<size_t>(k)];
+    const Mat3& to_unit = e.to_unit;
     const Vec3 q = to_unit * (x - e.centre);
     const float q2 = q.squaredNorm();
     float d = 0.0f;

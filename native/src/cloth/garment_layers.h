@@ -44,9 +44,9 @@ class ClothShell {
   static constexpr int kHostEvery = 16;
 
   // Measures the cloth: its particle positions (xyz; w ignored) lying where `ellipsoids` are (the
-  // ellipsoids at the end of the last step). Each particle lies on the ellipsoid it is deepest in
-  // or nearest to (the smallest |q| in that ellipsoid's unit space, among those whose box grown by
-  // kReachM holds it); its distance outside that ellipsoid ((|q| - 1) / |grad |q||: exact on a
+  // ellipsoids at the end of the last step, refreshed: their cached to_unit is the unit map used).
+  // Each particle lies on the ellipsoid it is deepest in or nearest to (the smallest |q| in that
+  // ellipsoid's unit space, among those whose bounding sphere grown by kReachM holds it); its distance outside that ellipsoid ((|q| - 1) / |grad |q||: exact on a
   // sphere, to first order on an ellipsoid; 0 inside) counts when it is at most kReachM, and the
   // kQuantile of the distances that count on an ellipsoid is its offset (0: no cloth on it).
   // Non-finite positions are skipped.
@@ -64,7 +64,6 @@ class ClothShell {
   size_t hosts_ellipsoids_ = 0;
   // Scratch, kept so that a measure allocates nothing once sizes settle.
   std::vector<Eigen::Vector4f> spheres_;  // each ellipsoid's centre, and its radius + reach squared
-  std::vector<Mat3> units_;              // each ellipsoid's world -> unit map
   std::vector<float> dist_, bucketed_;   // each particle's distance (-1: none); by ellipsoid
   std::vector<uint32_t> bucket_start_, fill_;
 };
