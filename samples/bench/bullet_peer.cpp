@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <memory>
 
@@ -71,12 +72,19 @@ void finish(PeerSide& side, const StretchMeter& st, const PenetrationMeter& pen,
 
 bool bulletAvailable() { return true; }
 
-bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, int iterations, PeerResult& out,
-                   std::string& error) {
+bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, int iterations, double sdf_voxel_m,
+                   PeerResult& out, std::string& error) {
   out = PeerResult{};
+  if (!(sdf_voxel_m >= 0.001 && sdf_voxel_m <= 10.0)) {
+    error = "the distance-field voxel must be in [0.001, 10] m";
+    return false;
+  }
   out.substeps_per_60hz = substeps_per_60hz;
   out.iterations = iterations;
-  out.label = std::to_string(substeps_per_60hz) + " x " + std::to_string(iterations);
+  out.sdf_voxel_m = sdf_voxel_m;
+  char field[48];
+  std::snprintf(field, sizeof field, ", %g cm field", 100.0 * sdf_voxel_m);
+  out.label = std::to_string(substeps_per_60hz) + " x " + std::to_string(iterations) + field;
   out.take = take.name;
   out.rate_hz = take.rate_hz;
 
@@ -160,6 +168,9 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
   info.air_density = 0;
   info.water_density = 0;
   info.m_sparsesdf.Initialize();
+  // The voxel Reset() restores (it runs below whenever a radius changes).
+  info.m_sparsesdf.setDefaultVoxelsz(static_cast<btScalar>(sdf_voxel_m));
+  info.m_sparsesdf.Reset();
   w.world.setGravity(info.m_gravity);
   std::vector<btScalar> xyz;
   for (const drape_vec3& p : rest) xyz.insert(xyz.end(), {p.x, p.y, p.z});

@@ -9,7 +9,11 @@
 // mass: 0.2 kg/m^2), its attached nodes as kinematic nodes moved to the same targets across the
 // substeps, each tracking ellipsoid as a kinematic btMultiSphereShape (one unit sphere, scaled by
 // the radii) moved across the substeps, gravity, 4 mm collision margin (Drape's), `substeps` fixed
-// substeps per 1/60 s and `iterations` position iterations. Bullet: its stepSimulation calls are
+// substeps per 1/60 s and `iterations` position iterations. Bullet's soft body meets a rigid
+// shape through a sparse signed-distance field sampled on a voxel grid (btSparseSdf), 0.25 m by
+// default: sized for metre-scale objects, it is coarser than a forearm (4 cm radius) and lets a
+// quarter of the garment sink into the body; `sdf_voxel_m` sets it (kBulletFieldM by default,
+// docs/benchmarks.md, "The Bullet peer's distance field"). Bullet: its stepSimulation calls are
 // timed; Drape: its whole frame (push + step: skeleton, body, proxies, cloth) beside it, in the
 // same frame; both in thread CPU time (and wall time).
 // Both garments are measured by the same meters (metrics.h) on the same frames (all but the first).
@@ -34,12 +38,18 @@ struct PeerSide {
   bool finite = true;
 };
 
+// The peer's distance-field voxel (m): 5 cm, the coarsest of the sizes measured that keeps the
+// shirt on the body (docs/benchmarks.md); Bullet's own default is 0.25 m.
+constexpr double kBulletFieldM = 0.05;
+constexpr double kBulletDefaultFieldM = 0.25;
+
 struct PeerResult {
-  std::string label;  // e.g. "4 x 10"
+  std::string label;  // e.g. "4 x 10, 5 cm field"
   std::string take;
   double rate_hz = 0;
   int substeps_per_60hz = 0;
   int iterations = 0;
+  double sdf_voxel_m = 0;  // Bullet's distance-field voxel
   uint32_t particles = 0;
   PeerSide bullet, drape;
 };
@@ -47,7 +57,7 @@ struct PeerResult {
 // True when this drape-bench was built with Bullet.
 bool bulletAvailable();
 // Runs one Bullet setting beside Drape's default one. false + error on failure.
-bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, int iterations, PeerResult& out,
-                   std::string& error);
+bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, int iterations, double sdf_voxel_m,
+                   PeerResult& out, std::string& error);
 
 }  // namespace bench

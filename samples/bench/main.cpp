@@ -47,6 +47,7 @@ struct Options {
   bool quick = false;
   bool help = false;
   bool bullet = true;
+  double bullet_field_m = bench::kBulletFieldM;  // the peer's distance-field voxel
   bool plots = true;
   std::string out = "drape-bench-out";
   std::vector<TakeSpec> takes;
@@ -58,7 +59,8 @@ struct Options {
 
 const char* kHelp =
     "usage: drape-bench [--quick] [--out DIR] [--take PATH[@STRIDE]]... [--seconds S] [--repeats N]\n"
-    "                   [--sweeps a,b,...] [--energy-seconds S] [--no-bullet] [--no-plots]\n"
+    "                   [--sweeps a,b,...] [--energy-seconds S] [--no-bullet] [--bullet-field M]\n"
+    "                   [--no-plots]\n"
     "Sweeps Drape's speed/accuracy settings over real takes and writes, into DIR (default\n"
     "drape-bench-out): <sweep>.csv and <sweep>.png per sweep, bullet_peer.csv, summary.md.\n"
     "  --quick           a few points per sweep, one 1 s take, one repeat (CI: under a minute)\n"
@@ -70,7 +72,9 @@ const char* kHelp =
     "  --sweeps LIST     subset of: solver,substeps,iterations,strain_limit,ring_points,\n"
     "                    contact_response,continuous_collision,resolution,backend\n"
     "  --energy-seconds S  free-hanging energy-drift run length (default 2, quick 0.5)\n"
-    "  --no-bullet       skip the Bullet peer;  --no-plots  skip gnuplot\n";
+    "  --no-bullet       skip the Bullet peer;  --no-plots  skip gnuplot\n"
+    "  --bullet-field M  the Bullet peer's distance-field voxel in metres, [0.005, 1] (default 0.05;\n"
+    "                    a full run also runs 4 x 10 at Bullet's own 0.25 and at 0.02)\n";
 
 bool parseNumber(const std::string& s, double lo, double hi, double& out) {
   char* end = nullptr;
@@ -122,6 +126,9 @@ bool parse(int argc, char** argv, Options& o, std::string& err) {
     } else if (a == "--repeats") {
       if (!value(v) || !parseNumber(v, 1, 100, d)) return err = "--repeats must be in [1, 100]", false;
       o.repeats = static_cast<int>(d);
+    } else if (a == "--bullet-field") {
+      if (!value(v) || !parseNumber(v, 0.005, 1, o.bullet_field_m))
+        return err = "--bullet-field must be in [0.005, 1] (metres)", false;
     } else if (a == "--sweeps") {
       if (!value(v)) return false;
       std::stringstream ss(v);
@@ -343,20 +350,33 @@ int run(int argc, char** argv) {
   if (opt.bullet && !bulletAvailable()) {
     std::string why;
     PeerResult unused;
-    runBulletPeer(takes[0], 0, 0, 0, unused, why);
+    runBulletPeer(takes[0], 0, 0, 0, opt.bullet_field_m, unused, why);
     report.peer_note = why;
     std::fprintf(stderr, "drape-bench: note: %s\n", why.c_str());
   } else if (opt.bullet) {
-    const std::vector<std::pair<int, int>> settings =
-        opt.quick ? std::vector<std::pair<int, int>>{{4, 10}} : std::vector<std::pair<int, int>>{{1, 10}, {4, 10}};
+    report.peer_field_m = opt.bullet_field_m;
+    // (substeps per 1/60 s, iterations, distance-field voxel): the peer's field for both settings,
+    // and in a full run 4 x 10 also on Bullet's own 0.25 m field and on a finer 2 cm one, which
+    // show what the field buys (docs/benchmarks.md, "The Bullet peer's distance field").
+    struct PeerSetting {
+      int substeps, iterations;
+      double field_m;
+    };
+    const double f = opt.bullet_field_m;
+    std::vector<PeerSetting> settings = {{4, 10, f}};
+    if (!opt.quick) {
+      settings = {{1, 10, f}, {4, 10, f}};
+      for (double extra : {kBulletDefaultFieldM, 0.02})
+        if (extra != f) settings.push_back({4, 10, extra});
+    }
     // Every take in a full run (the BVH take is replayed at 60 Hz, the rate Bullet's and NvCloth's
     // figures are quoted for); the first one with --quick.
     const size_t peer_takes = opt.quick ? 1 : takes.size();
     for (size_t ti = 0; ti < peer_takes; ++ti) {
-      for (const auto& [sub, it] : settings) {
+      for (const PeerSetting& ps : settings) {
         PeerResult p;
         const auto t0 = std::chrono::steady_clock::now();
-        if (!runBulletPeer(takes[ti], table1_target, sub, it, p, err)) {
+        if (!runBulletPeer(takes[ti], table1_target, ps.substeps, ps.iterations, ps.field_m, p, err)) {
           std::fprintf(stderr, "drape-bench: error: Bullet peer: %s\n", err.c_str());
           return kExitFailure;
         }
