@@ -83,7 +83,7 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
   out.iterations = iterations;
   out.sdf_voxel_m = sdf_voxel_m;
   char field[48];
-  std::snprintf(field, sizeof field, ", %g cm field", 100.0 * sdf_voxel_m);
+  std::snprintf(field, sizeof field, " (%g cm field)", 100.0 * sdf_voxel_m);
   out.label = std::to_string(substeps_per_60hz) + " x " + std::to_string(iterations) + field;
   out.take = take.name;
   out.rate_hz = take.rate_hz;
@@ -207,7 +207,10 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
     shape->setLocalScaling(bt(e_end[k].radii));
     btRigidBody::btRigidBodyConstructionInfo ci(0, nullptr, shape.get());
     ci.m_startWorldTransform = pose(e_end[k]);
-    ci.m_friction = cloth.kinetic_friction;
+    // Bullet's soft-rigid contact takes kDF times the rigid body's friction as its coefficient
+    // (btSoftBody's collision callback: fc = m_cfg.kDF * getFriction()): 1 here, so the cloth
+    // meets Drape's kinetic friction (kDF above), not its square.
+    ci.m_friction = 1.0;
     auto body_rb = std::make_unique<btRigidBody>(ci);
     body_rb->setCollisionFlags(body_rb->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
     body_rb->setActivationState(DISABLE_DEACTIVATION);
@@ -253,10 +256,11 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
         btTransform now;
         now.setOrigin(a.getOrigin().lerp(b.getOrigin(), t));
         now.setRotation(a.getRotation().slerp(b.getRotation(), t));
-        btRigidBody& rb = *w.bodies[k];
-        rb.setLinearVelocity((b.getOrigin() - a.getOrigin()) / static_cast<btScalar>(dt));
-        rb.setWorldTransform(now);
-        rb.setInterpolationWorldTransform(now);
+        // Only the pose: stepSimulation (saveKinematicState) takes a kinematic body's linear and
+        // angular velocity from its last pose to this one, the velocity its contacts and
+        // friction see. Setting the velocity here, or the last pose to this one, would be
+        // overwritten by, or zero, that velocity.
+        w.bodies[k]->setWorldTransform(now);
       }
       for (uint32_t k = 0; k < nv; ++k) {
         if (!pinned[k]) continue;

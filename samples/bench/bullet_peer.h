@@ -1,18 +1,20 @@
 // The peer in the same run: Bullet's soft-body cloth (Debian libbullet-dev, 3.24) dressed in the
 // same T-shirt mesh on the same body, replayed over the same take at the same frame rate.
 //
-// A Drape context runs alongside as the driver: it tracks the body, builds the tracking
-// ellipsoids and the body mesh, and its own garment (the default setting) gives the attachment
-// targets (its pinned particles end every step at their targets) and the starting shape (the
-// garment once placed on the first tracked pose). Bullet gets: a soft body made from the garment's
-// rest positions and triangles (links from the edges, bending constraints at distance 2, the same
-// mass: 0.2 kg/m^2), its attached nodes as kinematic nodes moved to the same targets across the
-// substeps, each tracking ellipsoid as a kinematic btMultiSphereShape (one unit sphere, scaled by
-// the radii) moved across the substeps, gravity, 4 mm collision margin (Drape's), `substeps` fixed
-// substeps per 1/60 s and `iterations` position iterations. Bullet's soft body meets a rigid
-// shape through a sparse signed-distance field sampled on a voxel grid (btSparseSdf), 0.25 m by
-// default: sized for metre-scale objects, it is coarser than a forearm (4 cm radius) and lets a
-// quarter of the garment sink into the body; `sdf_voxel_m` sets it (kBulletFieldM by default,
+// A Drape context runs alongside as the driver: it tracks the body, builds the tracking ellipsoids
+// and the body mesh, and its own garment (the default setting) gives the attachment targets (its
+// pinned particles end every step at their targets) and the starting shape (the garment once placed
+// on the first tracked pose). Bullet gets: a soft body made from the garment's rest positions and
+// triangles (links from the edges, bending constraints at distance 2, the same mass: 0.2 kg/m^2),
+// its attached nodes as kinematic nodes moved to the same targets across the substeps, each
+// tracking ellipsoid as a kinematic btMultiSphereShape (one unit sphere, scaled by the radii) moved
+// across the substeps (Bullet derives its velocity from pose to pose, which its contacts and
+// friction use), friction at Drape's kinetic coefficient (Bullet multiplies the soft body's kDF by
+// the rigid body's friction: 0.4 x 1), gravity, 4 mm collision margin (Drape's), `substeps` fixed
+// substeps per 1/60 s and `iterations` position iterations. Bullet's soft body meets a rigid shape
+// through a sparse signed-distance field sampled on a voxel grid (btSparseSdf), 0.25 m by default:
+// sized for metre-scale objects, it is coarser than a forearm (4 cm radius) and lets a quarter of
+// the garment sink into the body; `sdf_voxel_m` sets it (kBulletFieldM by default,
 // docs/benchmarks.md, "The Bullet peer's distance field"). Bullet: its stepSimulation calls are
 // timed; Drape: its whole frame (push + step: skeleton, body, proxies, cloth) beside it, in the
 // same frame; both in thread CPU time (and wall time).
@@ -44,7 +46,7 @@ constexpr double kBulletFieldM = 0.05;
 constexpr double kBulletDefaultFieldM = 0.25;
 
 struct PeerResult {
-  std::string label;  // e.g. "4 x 10, 5 cm field"
+  std::string label;  // e.g. "4 x 10 (5 cm field)"
   std::string take;
   double rate_hz = 0;
   int substeps_per_60hz = 0;

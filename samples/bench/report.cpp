@@ -141,7 +141,7 @@ std::string renderReport(const ReportInput& in) {
       const double b = median(p.bullet.cpu_ms), d = median(p.drape.cpu_ms);
       const double bw = median(p.bullet.ms), dw = median(p.drape.ms);
       appendf(o,
-              "| %s (%.0f Hz, %u particles) | Bullet 3.24 | %s (substeps per 1/60 s x iterations, distance field) | %.2f (%.2f) | "
+              "| %s (%.0f Hz, %u particles) | Bullet 3.24 | %s (substeps per 1/60 s x iterations) | %.2f (%.2f) | "
               "%.2f | **%.0fx**; %.0fx | %.1f / %.1f | %.1f / %.1f | %.2f | %.1f |\n",
               p.take.c_str(), p.rate_hz, p.particles, p.label.c_str(), b, bw, b * p.rate_hz / 60.0, b / d, bw / dw,
               100.0 * p.bullet.stretch_p99, 100.0 * p.bullet.stretch_max, p.bullet.penetration_p99_mm,
