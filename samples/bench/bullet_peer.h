@@ -23,6 +23,7 @@
 
 #include "scenario.h"
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,10 @@ struct PeerSide {
 // shirt on the body (docs/benchmarks.md); Bullet's own default is 0.25 m.
 constexpr double kBulletFieldM = 0.05;
 constexpr double kBulletDefaultFieldM = 0.25;
+// Drape's setting with less stretch beside its default (docs/garments.md, "More strain-limit
+// passes"; Unity's DrapeDresser.lessStretch): the strain limit at 5 % in 8 passes.
+constexpr float kLessStretchLimit = 0.05f;
+constexpr uint32_t kLessStretchPasses = 8;
 
 struct PeerResult {
   std::string label;  // e.g. "4 x 10 (5 cm field)"
@@ -53,7 +58,9 @@ struct PeerResult {
   int iterations = 0;
   double sdf_voxel_m = 0;  // Bullet's distance-field voxel
   uint32_t particles = 0;
-  PeerSide bullet, drape;
+  // drape: the default setting, which drives Bullet; drape_less: kLessStretchLimit in
+  // kLessStretchPasses passes, in its own context beside it.
+  PeerSide bullet, drape, drape_less;
 };
 
 // True when this drape-bench was built with Bullet.
