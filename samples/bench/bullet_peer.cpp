@@ -68,6 +68,35 @@ void finish(PeerSide& side, const StretchMeter& st, const PenetrationMeter& pen,
   side.inside_mean = mean(inside);
 }
 
+// Frame i of the take into one Drape context: push, step, then its garment's vertices into x.
+// cpu_ms: thread CPU time of push + step; frame_ms: their wall time; cloth_ms: the garment step as
+// drape_garment_get_stats reports it.
+bool pushAndStep(drape_context* ctx, drape_garment* garment, const Take& take, size_t i, std::vector<drape_vec3>& x,
+                 double& frame_ms, double& cloth_ms, double& cpu_ms, std::string& error) {
+  drape_skeleton_frame f{};
+  f.struct_size = sizeof f;
+  f.layout = take.layout;
+  f.joint_count = take.joint_count;
+  f.timestamp_s = take.timestamps_s[i];
+  f.joints = take.frames[i].data();
+  const double dt = i == 0 ? 1.0 / take.rate_hz : take.timestamps_s[i] - take.timestamps_s[i - 1];
+  const Clock::time_point t0 = Clock::now();
+  const double c0 = threadCpuMs();
+  if (drape_result r = drape_context_push_skeleton(ctx, &f)) return failed("drape_context_push_skeleton", r, error);
+  if (drape_result r = drape_context_step(ctx, static_cast<float>(std::min(std::max(dt, 1e-4), 1.0))))
+    return failed("drape_context_step", r, error);
+  cpu_ms = threadCpuMs() - c0;
+  frame_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  drape_garment_stats gs{};
+  gs.struct_size = sizeof gs;
+  const uint32_t n = static_cast<uint32_t>(x.size());
+  if (!ok("drape_garment_get_stats", drape_garment_get_stats(garment, &gs), error) ||
+      !ok("drape_garment_read_mesh", drape_garment_read_mesh(garment, x.data(), nullptr, n, nullptr, 0), error))
+    return false;
+  cloth_ms = gs.step_ms;
+  return true;
+}
+
 }  // namespace
 
 bool bulletAvailable() { return true; }
@@ -142,60 +171,18 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
     return false;
   }
   std::vector<drape_vec3> x_less(nv);
-  auto pushStepLess = [&](size_t i, double& frame_ms, double& cloth_ms, double& cpu_ms) -> bool {
-    drape_skeleton_frame f{};
-    f.struct_size = sizeof f;
-    f.layout = take.layout;
-    f.joint_count = take.joint_count;
-    f.timestamp_s = take.timestamps_s[i];
-    f.joints = take.frames[i].data();
-    const double dt = i == 0 ? 1.0 / take.rate_hz : take.timestamps_s[i] - take.timestamps_s[i - 1];
-    const Clock::time_point t0 = Clock::now();
-    const double c0 = threadCpuMs();
-    if (drape_result r = drape_context_push_skeleton(ctx_less.get(), &f))
-      return failed("drape_context_push_skeleton", r, error);
-    if (drape_result r = drape_context_step(ctx_less.get(), static_cast<float>(std::min(std::max(dt, 1e-4), 1.0))))
-      return failed("drape_context_step", r, error);
-    cpu_ms = threadCpuMs() - c0;
-    frame_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-    drape_garment_stats gs{};
-    gs.struct_size = sizeof gs;
-    if (!ok("drape_garment_get_stats", drape_garment_get_stats(garment_less, &gs), error) ||
-        !ok("drape_garment_read_mesh", drape_garment_read_mesh(garment_less, x_less.data(), nullptr, nv, nullptr, 0),
-            error))
-      return false;
-    cloth_ms = gs.step_ms;
-    return true;
-  };
 
+  // The driver's frame: its garment, and what Bullet takes from it (ellipsoids, body mesh).
   auto pushStep = [&](size_t i, double& frame_ms, double& cloth_ms, double& cpu_ms) -> bool {
-    drape_skeleton_frame f{};
-    f.struct_size = sizeof f;
-    f.layout = take.layout;
-    f.joint_count = take.joint_count;
-    f.timestamp_s = take.timestamps_s[i];
-    f.joints = take.frames[i].data();
-    const double dt = i == 0 ? 1.0 / take.rate_hz : take.timestamps_s[i] - take.timestamps_s[i - 1];
-    const Clock::time_point t0 = Clock::now();
-    const double c0 = threadCpuMs();
-    if (drape_result r = drape_context_push_skeleton(ctx.get(), &f))
-      return failed("drape_context_push_skeleton", r, error);
-    if (drape_result r = drape_context_step(ctx.get(), static_cast<float>(std::min(std::max(dt, 1e-4), 1.0))))
-      return failed("drape_context_step", r, error);
-    cpu_ms = threadCpuMs() - c0;
-    frame_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-    drape_garment_stats gs{};
-    gs.struct_size = sizeof gs;
     uint32_t count = 0;
-    if (!ok("drape_garment_get_stats", drape_garment_get_stats(garment, &gs), error) ||
-        !ok("drape_context_read_ellipsoids", drape_context_read_ellipsoids(ctx.get(), e_end.data(), ne, &count),
-            error) ||
-        !ok("drape_garment_read_mesh", drape_garment_read_mesh(garment, x.data(), nullptr, nv, nullptr, 0), error) ||
-        !ok("drape_context_read_body_mesh",
-            drape_context_read_body_mesh(ctx.get(), body.data(), nullptr, body_nv, nullptr, 0), error))
-      return false;
-    cloth_ms = gs.step_ms;
-    return true;
+    return pushAndStep(ctx.get(), garment, take, i, x, frame_ms, cloth_ms, cpu_ms, error) &&
+           ok("drape_context_read_ellipsoids", drape_context_read_ellipsoids(ctx.get(), e_end.data(), ne, &count),
+              error) &&
+           ok("drape_context_read_body_mesh",
+              drape_context_read_body_mesh(ctx.get(), body.data(), nullptr, body_nv, nullptr, 0), error);
+  };
+  auto pushStepLess = [&](size_t i, double& frame_ms, double& cloth_ms, double& cpu_ms) -> bool {
+    return pushAndStep(ctx_less.get(), garment_less, take, i, x_less, frame_ms, cloth_ms, cpu_ms, error);
   };
   double frame_ms = 0, cloth_ms = 0, cpu_ms = 0;
   if (!pushStep(0, frame_ms, cloth_ms, cpu_ms) || !pushStepLess(0, frame_ms, cloth_ms, cpu_ms)) return false;
