@@ -73,18 +73,11 @@ void finish(PeerSide& side, const StretchMeter& st, const PenetrationMeter& pen,
 // drape_garment_get_stats reports it.
 bool pushAndStep(drape_context* ctx, drape_garment* garment, const Take& take, size_t i, std::vector<drape_vec3>& x,
                  double& frame_ms, double& cloth_ms, double& cpu_ms, std::string& error) {
-  drape_skeleton_frame f{};
-  f.struct_size = sizeof f;
-  f.layout = take.layout;
-  f.joint_count = take.joint_count;
-  f.timestamp_s = take.timestamps_s[i];
-  f.joints = take.frames[i].data();
-  const double dt = i == 0 ? 1.0 / take.rate_hz : take.timestamps_s[i] - take.timestamps_s[i - 1];
+  const drape_skeleton_frame f = skeletonFrame(take, i);
   const Clock::time_point t0 = Clock::now();
   const double c0 = threadCpuMs();
   if (drape_result r = drape_context_push_skeleton(ctx, &f)) return failed("drape_context_push_skeleton", r, error);
-  if (drape_result r = drape_context_step(ctx, static_cast<float>(std::min(std::max(dt, 1e-4), 1.0))))
-    return failed("drape_context_step", r, error);
+  if (drape_result r = drape_context_step(ctx, frameDt(take, i))) return failed("drape_context_step", r, error);
   cpu_ms = threadCpuMs() - c0;
   frame_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   drape_garment_stats gs{};

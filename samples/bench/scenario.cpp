@@ -27,6 +27,21 @@ std::string libraryError(const char* call, drape_result r) {
   return std::string(call) + " failed: " + drape_result_name(r) + (msg && *msg ? std::string(": ") + msg : "");
 }
 
+drape_skeleton_frame skeletonFrame(const Take& take, size_t i) {
+  drape_skeleton_frame f{};
+  f.struct_size = sizeof f;
+  f.layout = take.layout;
+  f.joint_count = take.joint_count;
+  f.timestamp_s = take.timestamps_s[i];
+  f.joints = take.frames[i].data();
+  return f;
+}
+
+float frameDt(const Take& take, size_t i) {
+  const double dt = i == 0 ? 1.0 / take.rate_hz : take.timestamps_s[i] - take.timestamps_s[i - 1];
+  return static_cast<float>(std::min(std::max(dt, 1e-4), 1.0));
+}
+
 bool failed(const char* call, drape_result r, std::string& error) {
   error = libraryError(call, r);
   return false;
@@ -215,19 +230,13 @@ bool runDrape(const Take& take, const Setting& s, const RunOptions& o, RunResult
   size_t openings_off_frames = 0;  // of the measured frames (one `inside` entry each)
   uint32_t refits = 0;
   for (size_t i = 0; i < take.frames.size(); ++i) {
-    drape_skeleton_frame f{};
-    f.struct_size = sizeof f;
-    f.layout = take.layout;
-    f.joint_count = take.joint_count;
-    f.timestamp_s = take.timestamps_s[i];
-    f.joints = take.frames[i].data();
-    const double dt = i == 0 ? 1.0 / take.rate_hz : take.timestamps_s[i] - take.timestamps_s[i - 1];
+    const drape_skeleton_frame f = skeletonFrame(take, i);
     const Clock::time_point t0 = Clock::now();
     if (drape_result r = drape_context_push_skeleton(ctx.get(), &f)) {
       error = libraryError("drape_context_push_skeleton", r);
       return false;
     }
-    if (drape_result r = drape_context_step(ctx.get(), static_cast<float>(std::min(std::max(dt, 1e-4), 1.0)))) {
+    if (drape_result r = drape_context_step(ctx.get(), frameDt(take, i))) {
       error = libraryError("drape_context_step", r);
       return false;
     }

@@ -101,6 +101,11 @@ bool templateTargetFor(uint32_t wanted, uint32_t& target, std::string& error);
 // Error text for a failed call: the result name and drape_last_error().
 std::string libraryError(const char* call, drape_result r);
 // For `if (drape_result r = call(...)) return failed("call", r, error);`: sets error, returns false.
+// Frame i of the take as drape_context_push_skeleton takes it (joints point into take), and the
+// step drape_context_step gets for it: the recording's dt (one period on the first frame),
+// clamped to [1e-4, 1] s.
+drape_skeleton_frame skeletonFrame(const Take& take, size_t i);
+float frameDt(const Take& take, size_t i);
 bool failed(const char* call, drape_result r, std::string& error);
 // True when r is DRAPE_OK; else sets error and returns false.
 bool ok(const char* call, drape_result r, std::string& error);
