@@ -59,14 +59,27 @@ struct World {
   }
 };
 
-void finish(PeerSide& side, const StretchMeter& st, const PenetrationMeter& pen, const std::vector<double>& inside) {
-  side.stretch_p99 = st.p99();
-  side.stretch_max = st.max();
-  side.penetration_p99_mm = pen.p99Mm();
-  side.penetration_max_mm = pen.maxMm();
-  side.deeper_than_2mm = pen.deeperThan2mmFraction();
-  side.inside_mean = mean(inside);
-}
+// One garment's meters, fed the same frames as the others (the same body surface, ellipsoids and
+// pinned vertices), then read into its PeerSide.
+struct GarmentMeters {
+  StretchMeter stretch;
+  PenetrationMeter pen;
+  std::vector<double> inside;
+  void addFrame(const BodySurface& body, const drape_vec3* x, size_t n, const std::vector<uint8_t>& pinned,
+                const std::vector<drape_ellipsoid>& ellipsoids) {
+    pen.addFrame(body, x, n);
+    stretch.addFrame(x);
+    inside.push_back(countInsideEllipsoids(x, n, pinned, ellipsoids));
+  }
+  void finish(PeerSide& side) const {
+    side.stretch_p99 = stretch.p99();
+    side.stretch_max = stretch.max();
+    side.penetration_p99_mm = pen.p99Mm();
+    side.penetration_max_mm = pen.maxMm();
+    side.deeper_than_2mm = pen.deeperThan2mmFraction();
+    side.inside_mean = mean(inside);
+  }
+};
 
 // Frame i of the take into one Drape context: push, step, then its garment's vertices into x.
 // cpu_ms: thread CPU time of push + step; frame_ms: their wall time; cloth_ms: the garment step as
@@ -245,13 +258,10 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
     w.bodies.push_back(std::move(body_rb));
   }
 
-  StretchMeter st_b, st_d;
-  st_b.setMesh(indices, rest);
-  st_d.setMesh(indices, rest);
-  StretchMeter st_l;
-  st_l.setMesh(indices, rest);
-  PenetrationMeter pen_b, pen_d, pen_l;
-  std::vector<double> in_b, in_d, in_l;
+  // Bullet's garment, Drape's default and Drape's setting with less stretch.
+  GarmentMeters m_bullet, m_drape, m_less;
+  for (GarmentMeters* m : {&m_bullet, &m_drape, &m_less}) m->stretch.setMesh(indices, rest);
+  BodySurface surface;
   std::vector<drape_vec3> pin_start(nv);
   for (size_t i = 1; i < take.frames.size(); ++i) {
     e_start = e_end;
@@ -315,25 +325,17 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
       if (!std::isfinite(bx[k].x) || !std::isfinite(bx[k].y) || !std::isfinite(bx[k].z)) out.bullet.finite = false;
     }
     // One body for all three: the two Drape contexts track the same frames the same way.
-    if (!pen_b.setBody(body, body_idx) || !pen_d.setBody(body, body_idx) || !pen_l.setBody(body, body_idx)) {
+    if (!surface.set(body, body_idx)) {
       error = "the body mesh could not be measured";
       return false;
     }
-    if (out.bullet.finite) {
-      pen_b.addFrame(bx.data(), nv);
-      st_b.addFrame(bx.data());
-      in_b.push_back(countInsideEllipsoids(bx.data(), nv, pinned, e_end));
-    }
-    pen_d.addFrame(x.data(), nv);
-    st_d.addFrame(x.data());
-    in_d.push_back(countInsideEllipsoids(x.data(), nv, pinned, e_end));
-    pen_l.addFrame(x_less.data(), nv);
-    st_l.addFrame(x_less.data());
-    in_l.push_back(countInsideEllipsoids(x_less.data(), nv, pinned, e_end));
+    if (out.bullet.finite) m_bullet.addFrame(surface, bx.data(), nv, pinned, e_end);
+    m_drape.addFrame(surface, x.data(), nv, pinned, e_end);
+    m_less.addFrame(surface, x_less.data(), nv, pinned, e_end);
   }
-  finish(out.bullet, st_b, pen_b, in_b);
-  finish(out.drape, st_d, pen_d, in_d);
-  finish(out.drape_less, st_l, pen_l, in_l);
+  m_bullet.finish(out.bullet);
+  m_drape.finish(out.drape);
+  m_less.finish(out.drape_less);
   return true;
 }
 

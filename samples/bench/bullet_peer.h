@@ -49,6 +49,8 @@ constexpr double kBulletDefaultFieldM = 0.25;
 // passes"; Unity's DrapeDresser.lessStretch): the strain limit at 5 % in 8 passes.
 constexpr float kLessStretchLimit = 0.05f;
 constexpr uint32_t kLessStretchPasses = 8;
+// "strain limit 5 % x 8 passes": that setting's name in bullet_peer.csv and summary.md.
+std::string lessStretchLabel();
 
 struct PeerResult {
   std::string label;  // e.g. "4 x 10 (5 cm field)"

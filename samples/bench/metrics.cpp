@@ -31,17 +31,21 @@ double mean(const std::vector<double>& v) {
 
 double maximum(const std::vector<double>& v) { return v.empty() ? kNaN : *std::max_element(v.begin(), v.end()); }
 
-bool PenetrationMeter::setBody(const std::vector<drape_vec3>& positions, const std::vector<uint32_t>& indices) {
+bool BodySurface::set(const std::vector<drape_vec3>& positions, const std::vector<uint32_t>& indices) {
   scratch_.resize(positions.size());
   for (size_t i = 0; i < positions.size(); ++i)
     scratch_[i] = drape::Vec3(positions[i].x, positions[i].y, positions[i].z);
   return bvh_.build(scratch_, indices);  // a refit after the first frame (same topology)
 }
 
-void PenetrationMeter::addFrame(const drape_vec3* vertices, size_t count) {
+double BodySurface::depthMm(const drape_vec3& v) const {
+  // The library's measure (GarmentSim::measure): inside by the winding number.
+  return static_cast<double>(bvh_.depthInside(drape::Vec3(v.x, v.y, v.z))) * 1000.0;
+}
+
+void PenetrationMeter::addFrame(const BodySurface& body, const drape_vec3* vertices, size_t count) {
   for (size_t i = 0; i < count; ++i) {
-    // The library's measure (GarmentSim::measure): inside by the winding number.
-    const double depth = static_cast<double>(bvh_.depthInside(drape::Vec3(vertices[i].x, vertices[i].y, vertices[i].z))) * 1000.0;
+    const double depth = body.depthMm(vertices[i]);
     depth_mm_.push_back(depth);
     if (depth > 2.0) ++deep_;
   }

@@ -20,21 +20,30 @@ double median(const std::vector<double>& v);
 double mean(const std::vector<double>& v);
 double maximum(const std::vector<double>& v);
 
-// Depth of garment vertices inside the body mesh (signed distance through drape's TriangleBvh,
-// the same query drape_garment_measure uses), pooled over frames.
-class PenetrationMeter {
+// This frame's body mesh as the penetration meters probe it (drape's TriangleBvh, the structure
+// drape_garment_measure uses): one per frame, however many garments are measured against it.
+class BodySurface {
  public:
   // body: this frame's body mesh (drape_context_read_body_mesh). Returns false if unusable.
-  bool setBody(const std::vector<drape_vec3>& positions, const std::vector<uint32_t>& indices);
-  void addFrame(const drape_vec3* vertices, size_t count);
+  bool set(const std::vector<drape_vec3>& positions, const std::vector<uint32_t>& indices);
+  // Depth of v inside the body (inside by the winding number), mm; 0 outside.
+  double depthMm(const drape_vec3& v) const;
+
+ private:
+  drape::TriangleBvh bvh_;
+  std::vector<drape::Vec3> scratch_;
+};
+
+// Depth of garment vertices inside the body mesh, pooled over frames.
+class PenetrationMeter {
+ public:
+  void addFrame(const BodySurface& body, const drape_vec3* vertices, size_t count);
   double p99Mm() const;
   double maxMm() const;
   double deeperThan2mmFraction() const;  // vertex-frames more than 2 mm inside
   size_t samples() const { return depth_mm_.size(); }
 
  private:
-  drape::TriangleBvh bvh_;
-  std::vector<drape::Vec3> scratch_;
   std::vector<double> depth_mm_;
   size_t deep_ = 0;
 };

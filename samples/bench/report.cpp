@@ -153,9 +153,9 @@ std::string renderReport(const ReportInput& in) {
       const PeerSide& l = p.drape_less;
       const double lc = median(l.cpu_ms), lw = median(l.ms);
       appendf(o,
-              "| | Drape | strain limit %g %% x %u passes, beside it | %.3f (%.3f) | %.3f | **%.0fx**; %.0fx | "
+              "| | Drape | %s, beside it | %.3f (%.3f) | %.3f | **%.0fx**; %.0fx | "
               "%.2f / %.1f | %.2f / %.1f | %.2f | %.2f |\n",
-              100.0 * kLessStretchLimit, kLessStretchPasses, lc, lw, lc * p.rate_hz / 60.0, b / lc, bw / lw,
+              lessStretchLabel().c_str(), lc, lw, lc * p.rate_hz / 60.0, b / lc, bw / lw,
               100.0 * l.stretch_p99, 100.0 * l.stretch_max, l.penetration_p99_mm, l.penetration_max_mm,
               100.0 * l.deeper_than_2mm, l.inside_mean);
     }
@@ -168,17 +168,11 @@ std::string renderReport(const ReportInput& in) {
         const bool less_pen = d.penetration_p99_mm <= p.bullet.penetration_p99_mm &&
                               d.deeper_than_2mm <= p.bullet.deeper_than_2mm;
         const bool less_stretch = d.stretch_p99 < p.bullet.stretch_p99;
-        char setting[96];
-        if (side == 0) {
-          std::snprintf(setting, sizeof setting, "Drape's default");
-        } else {
-          std::snprintf(setting, sizeof setting, "Drape with the strain limit at %g %% in %u passes",
-                        100.0 * kLessStretchLimit, kLessStretchPasses);
-        }
+        const std::string setting = side == 0 ? "Drape's default" : "Drape at " + lessStretchLabel();
         appendf(o,
                 "\nTarget on `%s` (Drape >= 50x faster than Bullet 4 x 10, with less penetration and stretch; "
                 "Bullet on its %g cm field), %s: %.0fx faster in CPU time (%s), penetration %s, stretch %s.%s",
-                p.take.c_str(), 100.0 * p.sdf_voxel_m, setting, ratio, ratio >= 50.0 ? "met" : "NOT met",
+                p.take.c_str(), 100.0 * p.sdf_voxel_m, setting.c_str(), ratio, ratio >= 50.0 ? "met" : "NOT met",
                 less_pen ? "less (met)" : "NOT less", less_stretch ? "less (met)" : "NOT less",
                 side == 0 ? "" : "\n");
         if (side == 0)

@@ -86,6 +86,12 @@ bool writeRowsCsv(const std::string& path, const std::vector<Row>& rows, std::st
   return true;
 }
 
+std::string lessStretchLabel() {
+  char label[64];
+  std::snprintf(label, sizeof label, "strain limit %g %% x %u passes", 100.0 * kLessStretchLimit, kLessStretchPasses);
+  return label;
+}
+
 bool writePeerCsv(const std::string& path, const std::vector<PeerResult>& peers, std::string& error) {
   std::unique_ptr<std::FILE, FileCloser> f(std::fopen(path.c_str(), "w"));
   if (!f) {
@@ -103,9 +109,7 @@ bool writePeerCsv(const std::string& path, const std::vector<PeerResult>& peers,
       "bullet_over_drape_wall,stretch_p99_pct,stretch_max_pct,pen_p99_mm,pen_max_mm,deeper_2mm_pct,"
       "inside_mean,sdf_voxel_m\n",
       f.get());
-  char less_label[64];
-  std::snprintf(less_label, sizeof less_label, "strain limit %g %% x %u", 100.0 * kLessStretchLimit,
-                kLessStretchPasses);
+  const std::string less_label = lessStretchLabel();
   for (const PeerResult& p : peers) {
     const double bullet_cpu = median(p.bullet.cpu_ms), bullet_wall = median(p.bullet.ms);
     for (int side = 0; side < 3; ++side) {
@@ -115,7 +119,7 @@ bool writePeerCsv(const std::string& path, const std::vector<PeerResult>& peers,
       std::fprintf(
           f.get(), "%s,%s,%s,%.4g,%u,%d,%d,%zu,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g\n",
           side == 0 ? "bullet" : "drape",
-          side == 0 ? csvText(p.label).c_str() : side == 1 ? "default" : less_label, csvText(p.take).c_str(),
+          side == 0 ? csvText(p.label).c_str() : side == 1 ? "default" : less_label.c_str(), csvText(p.take).c_str(),
           p.rate_hz, p.particles, side == 0 ? p.substeps_per_60hz : 0, side == 0 ? p.iterations : 0, s.cpu_ms.size(),
           cpu, percentile(s.cpu_ms, 90.0), cpu * p.rate_hz / 60.0, cpu * p.rate_hz, bullet_cpu / median(over.cpu_ms),
           median(s.ms), percentile(s.ms, 90.0), bullet_wall / median(over.ms), 100.0 * s.stretch_p99,

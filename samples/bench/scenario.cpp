@@ -222,6 +222,7 @@ bool runDrape(const Take& take, const Setting& s, const RunOptions& o, RunResult
           drape_context_read_body_mesh(ctx.get(), nullptr, nullptr, 0, body_idx.data(), body_ni), error))
     return false;
 
+  BodySurface surface;
   PenetrationMeter pen;
   StretchMeter stretch;
   stretch.setMesh(out.indices, out.rest);
@@ -286,11 +287,11 @@ bool runDrape(const Take& take, const Setting& s, const RunOptions& o, RunResult
     inside.push_back(acc.proxy_inside);
     if (acc.openings_off > 0) ++openings_off_frames;
     out.inside_max = std::max(out.inside_max, acc.proxy_inside);
-    if (!pen.setBody(body, body_idx)) {
+    if (!surface.set(body, body_idx)) {
       error = "the body mesh could not be measured (non-finite vertex?)";
       return false;
     }
-    pen.addFrame(x.data(), nv);
+    pen.addFrame(surface, x.data(), nv);
     stretch.addFrame(x.data());
   }
   out.substeps_per_frame = median(substeps);
