@@ -1,4 +1,5 @@
 // Particle–ellipsoid collision (native/src/proxies/collision.h, closest_point.h).
+#include "cloth/collider_motion.h"
 #include "proxies/closest_point.h"
 #include "proxies/collision.h"
 
@@ -1024,6 +1025,77 @@ TEST(Collider, ExactShallowContactsMatchTheReference) {
     std::printf("[ exact    ] radii %.3f %.3f %.3f: 5000 shallow contacts, worst |d - d_ref| = %.2g m\n",
                 e.radii.x(), e.radii.y(), e.radii.z(), worst);
   }
+}
+
+// A step of several collision spans keeps one grid (ColliderMotion's hold boxes): every span's
+// contacts must be those of a collider given the span's ellipsoids by setEllipsoids (its own grid
+// from its swept boxes), bit for bit, and the step must build one grid, not one per span. Turns
+// up to 2.6 rad per step stress the hold boxes' rotation bound.
+TEST(Collider, SpanGridKeptAcrossStepSameContacts) {
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    Scene s = randomScene(120, test::repeatsUnderSanitizers(3000, 4), 700u + seed);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    for (size_t k = 0; k < s.end.size(); ++k) {  // larger turns than randomScene's
+      const Quat dq(Eigen::AngleAxisf(2.6f * u(rng), test::draw3(u, rng).normalized()));
+      s.end[k] = makeEllipsoid(s.end[k].centre, s.end[k].radii, (dq * Quat(s.end[k].rotation)).toRotationMatrix());
+    }
+    const int count = static_cast<int>(s.start.size());
+    for (int stride : {1, 2, 3}) {
+      EllipsoidCollider held, direct;
+      ColliderMotion motion;
+      std::string error;
+      ASSERT_TRUE(motion.set(&held, s.start.data(), s.end.data(), count, 0.004f, error)) << error;
+      const int n = 10;
+      std::vector<Ellipsoid> a = s.start, b(s.start.size());
+      const uint64_t builds_before = held.gridBuilds();
+      for (int s0 = 0; s0 < n; s0 += stride) {
+        const int s1 = std::min(n, s0 + stride);
+        ASSERT_EQ(motion.beginSpan(s0, s1, n), &held);
+        const float t = s1 >= n ? 1.0f : static_cast<float>(s1) / static_cast<float>(n);
+        for (int k = 0; k < count; ++k) b[k] = t == 1.0f ? s.end[k] : interpolateEllipsoidPose(s.start[k], s.end[k], t);
+        direct.setEllipsoids(a.data(), b.data(), count, 0.004f);
+        for (int cont = 0; cont < 2; ++cont) {
+          CollisionParams p;
+          p.continuous = cont != 0;
+          std::vector<Vec4> x_held = s.x, x_direct = s.x;
+          const CollisionStats st_held = held.collide(x_held.data(), s.prev.data(), x_held.size(), p);
+          const CollisionStats st_direct = direct.collide(x_direct.data(), s.prev.data(), x_direct.size(), p);
+          SCOPED_TRACE(::testing::Message() << "seed " << seed << ", stride " << stride << ", span " << s0 << "-" << s1
+                                            << ", continuous " << cont);
+          EXPECT_EQ(std::memcmp(x_held.data(), x_direct.data(), x_held.size() * sizeof(Vec4)), 0);
+          EXPECT_EQ(st_held.tests, st_direct.tests);
+          EXPECT_EQ(st_held.contacts, st_direct.contacts);
+          EXPECT_EQ(st_held.swept_catches, st_direct.swept_catches);
+          EXPECT_GT(st_held.contacts, 0u);
+        }
+        a = b;
+      }
+      EXPECT_EQ(held.gridBuilds() - builds_before, 1u) << "seed " << seed << ", stride " << stride;
+    }
+  }
+}
+
+// Hold boxes that do not hold a span's swept boxes (here: empty ones at the centres) are not
+// trusted: that span builds its own grid and the contacts stay those of setEllipsoids.
+TEST(Collider, SpanGridFromSweptBoxesWhenHoldBoxesDoNotHold) {
+  const Scene s = randomScene(60, test::repeatsUnderSanitizers(3000, 4), 811u);
+  const int count = static_cast<int>(s.start.size());
+  std::vector<Vec3> lo(s.start.size()), hi(s.start.size());
+  for (size_t k = 0; k < s.start.size(); ++k) lo[k] = hi[k] = s.start[k].centre;
+  EllipsoidCollider held, direct;
+  held.setSpanEllipsoids(s.start.data(), s.end.data(), count, 0.004f, lo.data(), hi.data());
+  direct.setEllipsoids(s.start.data(), s.end.data(), count, 0.004f);
+  held.setSpanEllipsoids(s.end.data(), s.end.data(), count, 0.004f, nullptr, nullptr);  // a second span
+  direct.setEllipsoids(s.end.data(), s.end.data(), count, 0.004f);
+  EXPECT_EQ(held.gridBuilds(), 2u);
+  CollisionParams p;
+  std::vector<Vec4> x_held = s.x, x_direct = s.x;
+  const CollisionStats a = held.collide(x_held.data(), s.prev.data(), x_held.size(), p);
+  const CollisionStats b = direct.collide(x_direct.data(), s.prev.data(), x_direct.size(), p);
+  EXPECT_EQ(std::memcmp(x_held.data(), x_direct.data(), x_held.size() * sizeof(Vec4)), 0);
+  EXPECT_EQ(a.contacts, b.contacts);
+  EXPECT_GT(a.contacts, 0u);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "cloth/collider_motion.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -103,8 +104,39 @@ EllipsoidCollider* ColliderMotion::beginSpan(int s0, int s1, int n) {
       e.rotation = Quat(scale0 * q.a.coeffs() + scale1 * q.b.coeffs()).toRotationMatrix();
     }
   }
-  collider_->setEllipsoids(a_.data(), b_.data(), count_, margin_);
+  if (s0 == 0) holdBoxes();
+  collider_->setSpanEllipsoids(a_.data(), b_.data(), count_, margin_, s0 == 0 ? hold_min_.data() : nullptr,
+                               s0 == 0 ? hold_max_.data() : nullptr);
   return collider_;
+}
+
+// Boxes holding ellipsoid k's box (radii + margin, as the collider inflates them) at every pose
+// between start_[k] and end_[k], so every span's swept box: the centre moves on the segment; the
+// half extent along axis i, |row i of R diag(r)|, is at most that of either end with r_hat (the
+// larger radii of the two ends: radii move linearly) plus r_hat_max |R(t)^T e_i - R_end^T e_i|,
+// and R(t) turns from the nearer end by at most half the rotation phi between them (the slerp's
+// arc): |R(t)^T e_i - R_end^T e_i| <= 2 sin(phi / 4) = sqrt(2 - 2 cos(phi / 2)) = sqrt(2 - 2 |d|),
+// d the quaternions' dot product. Never more than r_hat_max. Plus 1 mm for rounding; the collider
+// checks each span's swept box against its hold box and builds its own grid if one leaves it.
+void ColliderMotion::holdBoxes() {
+  hold_min_.resize(static_cast<size_t>(count_));
+  hold_max_.resize(static_cast<size_t>(count_));
+  constexpr float kSlack = 1e-3f;
+  for (int k = 0; k < count_; ++k) {
+    const Ellipsoid& a = start_[k];
+    const Ellipsoid& b = end_[k];
+    Vec3 r;
+    for (int i = 0; i < 3; ++i) r[i] = std::max(std::max(a.radii[i], b.radii[i]) + margin_, 1e-6f);
+    const float r_max = r.maxCoeff();
+    const float turn = r_max * std::sqrt(std::max(0.0f, 2.0f - 2.0f * std::abs(slerp_[static_cast<size_t>(k)].d)));
+    for (int i = 0; i < 3; ++i) {
+      const float ha = a.rotation.row(i).cwiseProduct(r.transpose()).norm();
+      const float hb = b.rotation.row(i).cwiseProduct(r.transpose()).norm();
+      const float half = std::min(r_max, std::max(ha, hb) + turn) + kSlack;
+      hold_min_[static_cast<size_t>(k)][i] = std::min(a.centre[i], b.centre[i]) - half;
+      hold_max_[static_cast<size_t>(k)][i] = std::max(a.centre[i], b.centre[i]) + half;
+    }
+  }
 }
 
 }  // namespace drape

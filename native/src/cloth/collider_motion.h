@@ -46,6 +46,9 @@ class ColliderMotion {
     bool linear = true;  // |d| >= 1 - epsilon: Eigen's slerp blends linearly
   };
   std::vector<Slerp> slerp_;
+  // The step's hold boxes (EllipsoidCollider::setSpanEllipsoids), made by holdBoxes() at its first span.
+  void holdBoxes();
+  std::vector<Vec3> hold_min_, hold_max_;
 };
 
 }  // namespace drape

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <utility>
 
 namespace drape {
 using namespace collision_internal;
@@ -127,10 +128,54 @@ Ellipsoid EllipsoidCollider::inflatedEnd(int i) const {
 
 void EllipsoidCollider::setEllipsoids(const Ellipsoid* start, const Ellipsoid* end, int count,
                                       float margin_m) {
+  hold_count_ = 0;  // a later span cannot keep a grid this call builds
+  hold_built_ = false;
+  if (!setShapes(start, end, count, margin_m) || count > kMaxGridEllipsoids) return;
+  buildGrid(count, [this](int k) { return std::make_pair(&shapes_[static_cast<size_t>(k)].swept_min,
+                                                        &shapes_[static_cast<size_t>(k)].swept_max); });
+}
+
+void EllipsoidCollider::setSpanEllipsoids(const Ellipsoid* start, const Ellipsoid* end, int count, float margin_m,
+                                          const Vec3* hold_min, const Vec3* hold_max) {
+  if (hold_min && hold_max && count > 0) {
+    hold_min_.assign(hold_min, hold_min + count);
+    hold_max_.assign(hold_max, hold_max + count);
+    hold_count_ = count;
+    hold_built_ = false;
+  }
+  if (!setShapes(start, end, count, margin_m) || count > kMaxGridEllipsoids) {
+    hold_built_ = false;
+    return;
+  }
+  // Every swept box of this span inside its ellipsoid's hold box (finite): the grid built from
+  // the hold boxes lists each ellipsoid in every cell its swept box touches.
+  bool held = hold_count_ == count;
+  for (int k = 0; k < count && held; ++k) {
+    const Shape& s = shapes_[static_cast<size_t>(k)];
+    if (!(s.swept_min.x() <= s.swept_max.x())) continue;  // not in the grid
+    const Vec3& lo = hold_min_[static_cast<size_t>(k)];
+    const Vec3& hi = hold_max_[static_cast<size_t>(k)];
+    held = isFinite(lo) && isFinite(hi) && (lo.array() <= s.swept_min.array()).all() &&
+           (s.swept_max.array() <= hi.array()).all();
+  }
+  if (held) {
+    if (!hold_built_)
+      buildGrid(count, [this](int k) { return std::make_pair(&hold_min_[static_cast<size_t>(k)],
+                                                            &hold_max_[static_cast<size_t>(k)]); });
+    grid_ = true;
+    hold_built_ = true;
+    return;
+  }
+  buildGrid(count, [this](int k) { return std::make_pair(&shapes_[static_cast<size_t>(k)].swept_min,
+                                                        &shapes_[static_cast<size_t>(k)].swept_max); });
+  hold_built_ = false;
+}
+
+bool EllipsoidCollider::setShapes(const Ellipsoid* start, const Ellipsoid* end, int count, float margin_m) {
   grid_ = false;
   if (!start || !end || count <= 0) {
     shapes_.clear();
-    return;
+    return false;
   }
   const float margin = (margin_m >= 0.0f && std::isfinite(margin_m)) ? margin_m : 0.0f;
   // What the last call built for its end ellipsoids is valid for this call's start ones at the
@@ -217,13 +262,30 @@ void EllipsoidCollider::setEllipsoids(const Ellipsoid* start, const Ellipsoid* e
     s.graze = (1.0f - graze) * (1.0f - graze);
     refreshQuick(k);
   }
-  if (!any || count > kMaxGridEllipsoids) return;
+  return any;
+}
 
+template <class BoxOf>
+void EllipsoidCollider::buildGrid(int count, BoxOf box_of) {
+  // The union of the boxes of the shapes in the grid: for the swept boxes, grid_min_ / grid_max_
+  // as setShapes computed them (the same operations in the same order).
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  Vec3 box_min = Vec3::Constant(kInf), box_max = Vec3::Constant(-kInf);
+  for (int k = 0; k < count; ++k) {
+    const Shape& s = shapes_[static_cast<size_t>(k)];
+    if (!(s.swept_min.x() <= s.swept_max.x())) continue;
+    const auto b = box_of(k);
+    for (int i = 0; i < 3; ++i) {
+      box_min[i] = std::min(box_min[i], (*b.first)[i]);
+      box_max[i] = std::max(box_max[i], (*b.second)[i]);
+    }
+  }
+  ++grid_builds_;
   words_ = (count + 63) / 64;
-  // Near-cubic cells, about kGridCells of them over the union of the swept boxes (a body:
-  // ~8 cm cells), at most kGridMaxPerAxis along an axis and 2 * kGridCells in all, so the
-  // storage reserved below is never exceeded.
-  const Vec3 extent = (grid_max_ - grid_min_).cwiseMax(Vec3::Constant(1e-4f));
+  // Near-cubic cells, about kGridCells of them over the union of the boxes (a body: ~8 cm
+  // cells), at most kGridMaxPerAxis along an axis and 2 * kGridCells in all, so the storage
+  // reserved below is never exceeded.
+  const Vec3 extent = (box_max - box_min).cwiseMax(Vec3::Constant(1e-4f));
   const float cell = std::cbrt(extent.prod() / static_cast<float>(kGridCells));
   for (int a = 0; a < 3; ++a) {
     const float cells_a = std::ceil(extent[a] / cell);
@@ -237,7 +299,7 @@ void EllipsoidCollider::setEllipsoids(const Ellipsoid* start, const Ellipsoid* e
   for (int a = 0; a < 3; ++a) grid_scale_[a] = static_cast<float>(dims_[a]) / extent[a];
   const size_t capacity = static_cast<size_t>(2 * kGridCells * words_);
   if (cells_.capacity() < capacity) cells_.reserve(capacity);
-  cell_origin_ = Eigen::Array4f(grid_min_.x(), grid_min_.y(), grid_min_.z(), 0.0f);
+  cell_origin_ = Eigen::Array4f(box_min.x(), box_min.y(), box_min.z(), 0.0f);
   cell_scale_ = Eigen::Array4f(grid_scale_.x(), grid_scale_.y(), grid_scale_.z(), 0.0f);
   // Largest float that still truncates to dims - 1.
   cell_top_ = Eigen::Array4f(std::nextafter(static_cast<float>(dims_[0]), 0.0f),
@@ -247,8 +309,9 @@ void EllipsoidCollider::setEllipsoids(const Ellipsoid* start, const Ellipsoid* e
   for (int k = 0; k < count; ++k) {
     const Shape& s = shapes_[static_cast<size_t>(k)];
     if (!(s.swept_min.x() <= s.swept_max.x())) continue;
-    const Eigen::Array4i lo = cellsOf(s.swept_min, cell_origin_, cell_scale_, cell_top_);
-    const Eigen::Array4i hi = cellsOf(s.swept_max, cell_origin_, cell_scale_, cell_top_);
+    const auto b = box_of(k);
+    const Eigen::Array4i lo = cellsOf(*b.first, cell_origin_, cell_scale_, cell_top_);
+    const Eigen::Array4i hi = cellsOf(*b.second, cell_origin_, cell_scale_, cell_top_);
     const uint64_t bit = uint64_t{1} << (k & 63);
     // Row by row through a local pointer: indexing cells_ with the members, re-read for every
     // cell (a store might change them, as far as the compiler knows), cost 0.7 % of the default

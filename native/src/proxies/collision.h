@@ -80,6 +80,16 @@ class EllipsoidCollider {
   // usual case: consecutive substeps share it), with the same result as computing it again.
   void setEllipsoids(const Ellipsoid* start, const Ellipsoid* end, int count,
                      float margin_m = kDefaultMargin);
+  // setEllipsoids for one collision span of a step of several (ColliderMotion), keeping the grid
+  // across the step: filling it is most of the set-up (~110 ellipsoids reach a T-shirt, each in a
+  // few cells of ~2 000, five spans a frame). hold_min / hold_max (count each, inflated by the
+  // margin as the collider's boxes are), given with a step's first span, are boxes that hold each
+  // ellipsoid's swept box in every span of the step; the grid is built from them once and the
+  // step's later spans (hold null) keep it. A span whose swept box leaves its hold box (or whose
+  // count differs) gets the grid built from its own swept boxes, as setEllipsoids. The grid only
+  // picks candidates for the box and narrow tests, so the contacts are the same bits either way.
+  void setSpanEllipsoids(const Ellipsoid* start, const Ellipsoid* end, int count, float margin_m,
+                         const Vec3* hold_min, const Vec3* hold_max);
 
   // positions: predicted positions at the substep end, xyz corrected in place; w = inverse mass,
   // particles with !(w > 0) (pinned) or a non-finite position are not touched.
@@ -90,6 +100,9 @@ class EllipsoidCollider {
                          const CollisionParams& params) const;
 
   int count() const { return static_cast<int>(shapes_.size()); }
+  // Grids built so far (setEllipsoids: one per call; setSpanEllipsoids: one per step when its
+  // hold boxes hold every span), for tests and profiling.
+  uint64_t gridBuilds() const { return grid_builds_; }
 
   // Rim edges (a[e], b[e]) of a garment's boundary loops against the end ellipsoids, after
   // collide(): an edge with an ellipsoid deep across its interior (a limb between two cuff
@@ -223,6 +236,11 @@ class EllipsoidCollider {
   Vec3 respond(const Shape& s, const Vec3& x, const Vec3& q, float r2, ContactResponse mode,
                Vec3& q_contact) const;
   void refreshQuick(int k);
+  // setEllipsoids' shapes, boxes and grid_min_ / grid_max_ (no grid); false: no ellipsoid to grid.
+  bool setShapes(const Ellipsoid* start, const Ellipsoid* end, int count, float margin_m);
+  // The grid over box_of(k) = (min, max) pointers for the shapes setShapes put in it.
+  template <class BoxOf>
+  void buildGrid(int count, BoxOf box_of);
   void contact(const Shape& s, const Eigen::Vector4f& q1, float r2, const Eigen::Vector4f& q0,
                float q0sq, bool inside, bool cont, bool friction, const Vec3& x0,
                const CollisionParams& p, Vec3& x, CollisionStats& st) const;
@@ -240,6 +258,12 @@ class EllipsoidCollider {
   Eigen::Array4f cell_origin_ = Eigen::Array4f::Zero(), cell_scale_ = Eigen::Array4f::Zero(),
                  cell_top_ = Eigen::Array4f::Zero();
   float margin_ = kDefaultMargin;
+  // setSpanEllipsoids: the step's hold boxes (hold_count_ of them, 0: none) and whether the grid
+  // now is the one built from them.
+  std::vector<Vec3> hold_min_, hold_max_;
+  int hold_count_ = 0;
+  bool hold_built_ = false;
+  uint64_t grid_builds_ = 0;
   // Collision groups (setGroups): group bit per ellipsoid, and for each of the 256 particle masks
   // the ellipsoids it may touch (kMaxGridEllipsoids / 64 words each).
   std::vector<uint8_t> groups_;
