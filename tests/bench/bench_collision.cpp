@@ -2,6 +2,7 @@
 // contact response (radial, exact), and one substep's collide() for 2 000 and 20 000 particles
 // against 40 ellipsoids placed like a body, with and without the broad phase.
 // Run: ./build/release/tests/drape_benchmarks --benchmark_filter=Collision --benchmark_repetitions=5
+#include "cloth/collider_motion.h"
 #include "proxies/closest_point.h"
 #include "proxies/collision.h"
 
@@ -239,6 +240,34 @@ void BM_CollisionSetEllipsoids(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_CollisionSetEllipsoids);
+
+// A cloth step's collider set-up as XpbdSolver::step runs it for a garment of 1 250 particles or
+// more (collision every second substep): ColliderMotion::set with the step's start and end
+// ellipsoids (this step's start = last step's end), then the five spans of a 10-substep step
+// (interpolated ellipsoids, the collider's shapes and one grid). Arg: the body's ellipsoids
+// repeated that many times (a T-shirt reaches ~110 of the ~140 of a default body).
+void BM_CollisionStepSetUp(benchmark::State& state) {
+  std::vector<Ellipsoid> a, b;
+  for (int r = 0; r < state.range(0); ++r) {
+    const std::vector<Ellipsoid> a_r = bodyEllipsoids(0.0f), b_r = bodyEllipsoids(0.01f);
+    a.insert(a.end(), a_r.begin(), a_r.end());
+    b.insert(b.end(), b_r.begin(), b_r.end());
+  }
+  EllipsoidCollider col;
+  ColliderMotion motion;
+  std::string error;
+  bool forward = true;
+  for (auto _ : state) {
+    // Steps alternate a -> b and b -> a, so each starts where the last one ended.
+    motion.set(&col, forward ? a.data() : b.data(), forward ? b.data() : a.data(), static_cast<int>(a.size()),
+               EllipsoidCollider::kDefaultMargin, error);
+    for (int s = 0; s < 10; s += 2) benchmark::DoNotOptimize(motion.beginSpan(s, s + 2, 10));
+    forward = !forward;
+    benchmark::ClobberMemory();
+  }
+  state.counters["ellipsoids"] = static_cast<double>(a.size());
+}
+BENCHMARK(BM_CollisionStepSetUp)->Arg(1)->Arg(3)->Unit(benchmark::kMicrosecond);
 
 // Args: particles, broad phase (0/1), scatter (0 = box, 1 = shell), response (0 radial, 1 exact),
 // lanes: pass 0 for 16 particles at once (16, the default where the CPU has AVX-512F; 8 there

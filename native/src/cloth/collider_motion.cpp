@@ -29,6 +29,13 @@ bool ColliderMotion::set(EllipsoidCollider* collider, const Ellipsoid* start, co
       }
     }
   }
+  // A step usually starts where the last one ended: its start rotation's unit quaternion is then
+  // the last step's end one (the same conversion of the same matrix), kept instead of recomputed.
+  const int kept = identical_ ? 0 : std::min(count, count_);
+  reuse_start_quat_.assign(static_cast<size_t>(count), 0);
+  for (int k = 0; k < kept; ++k)
+    reuse_start_quat_[static_cast<size_t>(k)] =
+        std::memcmp(start[k].rotation.data(), end_[k].rotation.data(), sizeof(Mat3)) == 0;
   collider_ = count > 0 ? collider : nullptr;
   count_ = count;
   margin_ = margin_m;
@@ -48,9 +55,13 @@ bool ColliderMotion::set(EllipsoidCollider* collider, const Ellipsoid* start, co
     const float one = 1.0f - Eigen::NumTraits<float>::epsilon();
     for (int k = 0; k < count; ++k) {
       Slerp& q = slerp_[static_cast<size_t>(k)];
-      q.a = Quat(start[k].rotation);
+      if (reuse_start_quat_[static_cast<size_t>(k)]) {
+        q.a = q.b;
+      } else {
+        q.a = Quat(start[k].rotation);
+        q.a.normalize();
+      }
       q.b = Quat(end[k].rotation);
-      q.a.normalize();
       q.b.normalize();
       q.d = q.a.dot(q.b);
       const float abs_d = std::abs(q.d);
@@ -76,20 +87,18 @@ EllipsoidCollider* ColliderMotion::beginSpan(int s0, int s1, int n) {
     return collider_;
   }
   const float t1 = s1 >= n ? 1.0f : static_cast<float>(s1) / static_cast<float>(n);
-  if (s0 == 0) {
-    a_ = start_;  // same size: no allocation
-  } else {
-    a_.swap(b_);  // the previous substep's end is this one's start
-  }
-  if (t1 == 1.0f) {
-    b_ = end_;
-  } else {
+  // The span starts where the previous one ended (the step's start for the first); its end is
+  // the step's end or the interpolation, written into whichever buffer the start is not in.
+  const Ellipsoid* from = s0 == 0 ? start_.data() : span_end_;
+  const Ellipsoid* to = end_.data();
+  if (t1 != 1.0f) {
+    std::vector<Ellipsoid>& out = from == a_.data() ? b_ : a_;
     for (int k = 0; k < count_; ++k) {
       // interpolateEllipsoidPose(start_[k], end_[k], t1) with the slerp's t-free part from set().
       const Ellipsoid& a = start_[k];
       const Ellipsoid& b = end_[k];
       const Slerp& q = slerp_[static_cast<size_t>(k)];
-      Ellipsoid& e = b_[k];
+      Ellipsoid& e = out[k];
       e.centre = a.centre + t1 * (b.centre - a.centre);
       e.radii = a.radii + t1 * (b.radii - a.radii);
       float scale0, scale1;
@@ -103,9 +112,11 @@ EllipsoidCollider* ColliderMotion::beginSpan(int s0, int s1, int n) {
       if (q.d < 0.0f) scale1 = -scale1;
       e.rotation = Quat(scale0 * q.a.coeffs() + scale1 * q.b.coeffs()).toRotationMatrix();
     }
+    to = out.data();
   }
+  span_end_ = to;
   if (s0 == 0) holdBoxes();
-  collider_->setSpanEllipsoids(a_.data(), b_.data(), count_, margin_, s0 == 0 ? hold_min_.data() : nullptr,
+  collider_->setSpanEllipsoids(from, to, count_, margin_, s0 == 0 ? hold_min_.data() : nullptr,
                                s0 == 0 ? hold_max_.data() : nullptr);
   return collider_;
 }

@@ -185,8 +185,8 @@ bool EllipsoidCollider::setShapes(const Ellipsoid* start, const Ellipsoid* end, 
   shapes_.resize(static_cast<size_t>(count));
   quick_.resize(static_cast<size_t>(count));
   constexpr float kInf = std::numeric_limits<float>::infinity();
-  grid_min_ = Vec3::Constant(kInf);
-  grid_max_ = Vec3::Constant(-kInf);
+  // The union of the swept boxes in locals (members would be stored and re-read every shape).
+  Vec3 union_min = Vec3::Constant(kInf), union_max = Vec3::Constant(-kInf);
   bool any = false;
 
   // to_unit = diag(1 / radii) R^T, from_unit = R diag(radii), the box's half extent the rows'
@@ -218,8 +218,9 @@ bool EllipsoidCollider::setShapes(const Ellipsoid* start, const Ellipsoid* end, 
     Shape& s = shapes_[static_cast<size_t>(k)];
     Vec3 start_radii, start_min, start_max;
     bool start_ok;
-    if (static_cast<size_t>(k) < reusable && same(start[k].centre, s.end_in_centre) &&
-        same(start[k].radii, s.end_in_radii) && same(start[k].rotation, s.end_in_rotation)) {
+    // s.end.centre and s.rotation are the last call's end ellipsoid's, as it received them.
+    if (static_cast<size_t>(k) < reusable && same(start[k].centre, s.end.centre) &&
+        same(start[k].radii, s.end_in_radii) && same(start[k].rotation, s.rotation)) {
       s.start = s.end;  // the previous end frame, built from this very ellipsoid
       start_min = s.end_built_min;
       start_max = s.end_built_max;
@@ -228,9 +229,7 @@ bool EllipsoidCollider::setShapes(const Ellipsoid* start, const Ellipsoid* end, 
       start_ok = build(start[k], s.start, start_radii, start_min, start_max);
     }
     s.end_built_ok = build(end[k], s.end, s.radii, s.end_built_min, s.end_built_max);
-    s.end_in_centre = end[k].centre;
     s.end_in_radii = end[k].radii;
-    s.end_in_rotation = end[k].rotation;
     s.end_min = s.end_built_min;
     s.end_max = s.end_built_max;
     const bool ok = s.end_built_ok && start_ok;
@@ -244,8 +243,8 @@ bool EllipsoidCollider::setShapes(const Ellipsoid* start, const Ellipsoid* end, 
     for (int i = 0; i < 3; ++i) {  // Eigen's cwiseMin / cwiseMax: std::min / std::max
       s.swept_min[i] = std::min(s.end_min[i], start_min[i]);
       s.swept_max[i] = std::max(s.end_max[i], start_max[i]);
-      grid_min_[i] = std::min(grid_min_[i], s.swept_min[i]);
-      grid_max_[i] = std::max(grid_max_[i], s.swept_max[i]);
+      union_min[i] = std::min(union_min[i], s.swept_min[i]);
+      union_max[i] = std::max(union_max[i], s.swept_max[i]);
     }
     any = true;
     int smallest = 0;
@@ -262,6 +261,8 @@ bool EllipsoidCollider::setShapes(const Ellipsoid* start, const Ellipsoid* end, 
     s.graze = (1.0f - graze) * (1.0f - graze);
     refreshQuick(k);
   }
+  grid_min_ = union_min;
+  grid_max_ = union_max;
   return any;
 }
 

@@ -144,12 +144,10 @@ class EllipsoidCollider {
     float inside_tol2 = 1.0f;          // |q|^2 below this: inside by more than the tolerance
     float graze = 0.0f;                // swept chords shallower than this (unit space) ignored
     int smallest_axis = 0;
-    // The end ellipsoid as setEllipsoids received it and what was built from it (its box kept
-    // even when the build failed and end_min/end_max were emptied): the next call's start when
-    // that is the same ellipsoid.
-    Vec3 end_in_centre = Vec3::Constant(std::numeric_limits<float>::quiet_NaN());
+    // The end ellipsoid's radii as setEllipsoids received them (its centre and rotation are
+    // end.centre and rotation) and the box built from it (kept even when the build failed and
+    // end_min / end_max were emptied): the next call's start when that is the same ellipsoid.
     Vec3 end_in_radii = Vec3::Zero();
-    Mat3 end_in_rotation = Mat3::Zero();
     Vec3 end_built_min, end_built_max;
     bool end_built_ok = false;
   };
