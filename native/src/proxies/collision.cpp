@@ -347,6 +347,28 @@ void EllipsoidCollider::refreshQuick(int k) {
   q.radii2_sqrt = q.radii2.cwiseSqrt();
   q.inside_tol2 = s.inside_tol2;
   q.graze = s.graze;
+  // The swept test's rejection bound (Quick::sweep_keep, collision_batch.inc): with U0, U1 the
+  // start and end to_unit, e1 = x1 - c1 and dx, dc the particle's and the centre's moves,
+  // q1 - q0 = (U1 - U0) e1 + U0 (dx - dc), |e1| <= r_max |q1|: |q1 - q0| <= alpha |q1| +
+  // gamma (|dx| + |dc|), alpha = |U1 - U0|_F r_max, gamma = |U0|_F. A path that came within the
+  // unit sphere is at least |q1| - 1 long, so |q1| (1 - alpha) > 1 + gamma |dc| + gamma |dx| (plus
+  // slack for the float tests) means no crossing. Computed in double, rounded the safe way.
+  double du = 0.0, g = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    for (int r = 0; r < 3; ++r) {
+      const double e = static_cast<double>(s.end.to_unit(r, c)) - static_cast<double>(s.start.to_unit(r, c));
+      const double u0 = s.start.to_unit(r, c);
+      du += e * e;
+      g += u0 * u0;
+    }
+  }
+  const double r_max = s.radii.maxCoeff();
+  const double gamma = std::sqrt(g) * (1.0 + 1e-6);
+  const double dc = (s.end.centre.cast<double>() - s.start.centre.cast<double>()).norm();
+  const double keep = (1.0 - std::sqrt(du) * r_max) * (1.0 - 1e-6) - 1e-6;
+  q.sweep_keep2 = keep > 0.0 ? static_cast<float>(keep * keep * (1.0 - 1e-6)) : 0.0f;
+  q.sweep_gamma = static_cast<float>(gamma);
+  q.sweep_k = static_cast<float>(1.0 + kSweepSlack + gamma * dc * (1.0 + 1e-6));
 }
 
 template <class F>
