@@ -55,9 +55,13 @@ size_t EllipsoidCollider::collideRims(Eigen::Vector4f* positions, size_t count, 
     Candidates c;
     if (!gather(xa.cwiseMin(xb), xa.cwiseMax(xb), use_grid, allowed, c)) continue;
     bool moved = false;
+    // The edge's box against each candidate's end box (the Quick copy: 4 lanes, one branch),
+    // re-taken after a push moves the ends.
+    Vec4 lo4 = lift(xa.cwiseMin(xb)), hi4 = lift(xa.cwiseMax(xb));
     iterate(c, [&](int k) {
+      const Quick& qk = quick_[static_cast<size_t>(k)];
+      if (!overlaps4(lo4, hi4, qk.end_min, qk.end_max)) return;
       const Shape& s = shapes_[static_cast<size_t>(k)];
-      if (!overlaps(xa.cwiseMin(xb), xa.cwiseMax(xb), s.end_min, s.end_max)) return;
       ++st.tests;
       const Vec3 q0 = s.end.to_unit * (xa - s.end.centre), q1 = s.end.to_unit * (xb - s.end.centre);
       const Vec3 d = q1 - q0;
@@ -93,6 +97,7 @@ size_t EllipsoidCollider::collideRims(Eigen::Vector4f* positions, size_t count, 
       if (!(den > 0.0f)) return;
       xa += (ca / den) * delta;
       xb += (cb / den) * delta;
+      lo4 = lift(xa.cwiseMin(xb)), hi4 = lift(xa.cwiseMax(xb));
       moved = true;
       ++st.contacts;
     });
