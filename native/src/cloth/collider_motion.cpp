@@ -29,13 +29,6 @@ bool ColliderMotion::set(EllipsoidCollider* collider, const Ellipsoid* start, co
       }
     }
   }
-  // A step usually starts where the last one ended: its start rotation's unit quaternion is then
-  // the last step's end one (the same conversion of the same matrix), kept instead of recomputed.
-  const int kept = identical_ ? 0 : std::min(count, count_);
-  reuse_start_quat_.assign(static_cast<size_t>(count), 0);
-  for (int k = 0; k < kept; ++k)
-    reuse_start_quat_[static_cast<size_t>(k)] =
-        std::memcmp(start[k].rotation.data(), end_[k].rotation.data(), sizeof(Mat3)) == 0;
   collider_ = count > 0 ? collider : nullptr;
   count_ = count;
   margin_ = margin_m;
@@ -55,13 +48,9 @@ bool ColliderMotion::set(EllipsoidCollider* collider, const Ellipsoid* start, co
     const float one = 1.0f - Eigen::NumTraits<float>::epsilon();
     for (int k = 0; k < count; ++k) {
       Slerp& q = slerp_[static_cast<size_t>(k)];
-      if (reuse_start_quat_[static_cast<size_t>(k)]) {
-        q.a = q.b;
-      } else {
-        q.a = Quat(start[k].rotation);
-        q.a.normalize();
-      }
+      q.a = Quat(start[k].rotation);
       q.b = Quat(end[k].rotation);
+      q.a.normalize();
       q.b.normalize();
       q.d = q.a.dot(q.b);
       const float abs_d = std::abs(q.d);

@@ -46,7 +46,6 @@ class ColliderMotion {
     bool linear = true;  // |d| >= 1 - epsilon: Eigen's slerp blends linearly
   };
   std::vector<Slerp> slerp_;
-  std::vector<uint8_t> reuse_start_quat_;  // set(): slerp_[k].b of the last step is this one's a
   const Ellipsoid* span_end_ = nullptr;    // the last span's end ellipsoids (start_, end_, a_ or b_)
   // The step's hold boxes (EllipsoidCollider::setSpanEllipsoids), made by holdBoxes() at its first span.
   void holdBoxes();

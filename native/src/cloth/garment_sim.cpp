@@ -738,13 +738,14 @@ void GarmentSim::stepBegin(const BodyModel& body, const std::vector<Ellipsoid>& 
       const Mat3 R = partialRotation(pr.frame * seen_pelvis_f_.transpose(), fa);
       const Vec3 t = fl * (pr.centre - seen_pelvis_c_);
       carry(R, seen_pelvis_c_, t, 1.0f);
+      // Centre and rotation only: the colliders (ColliderMotion, the OpenCL shapes) read centre,
+      // radii and rotation, not refresh()'s cache (to_unit and bounds are left stale).
       carried_start_.resize(start.size());
       for (size_t k = 0; k < start.size(); ++k) {
-        Ellipsoid e = start[k];
+        Ellipsoid& e = carried_start_[k];
+        e = start[k];
         e.centre = R * (e.centre - seen_pelvis_c_) + seen_pelvis_c_ + t;
         e.rotation = R * e.rotation;
-        e.refresh();
-        carried_start_[k] = e;
       }
       pinTargets(body, pins_);
       runStepFrame(carried_start_, end, pins_, dt);
