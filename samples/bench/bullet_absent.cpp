@@ -6,7 +6,7 @@ namespace bench {
 
 bool bulletAvailable() { return false; }
 
-bool runBulletPeer(const Take&, uint32_t, int, int, double, PeerResult&, std::string& error) {
+bool runBulletPeer(const Take&, uint32_t, int, int, double, PeerResult&, std::string& error, uint32_t) {
   error =
       "this drape-bench was built without Bullet (install libbullet-dev, e.g. bash .ci/install-deps.sh, and "
       "rebuild) so the peer comparison was skipped";

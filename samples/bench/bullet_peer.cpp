@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cmath>
 #include <memory>
+#include <random>
 
 #include <time.h>
 
@@ -108,7 +109,7 @@ bool pushAndStep(drape_context* ctx, drape_garment* garment, const Take& take, s
 bool bulletAvailable() { return true; }
 
 bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, int iterations, double sdf_voxel_m,
-                   PeerResult& out, std::string& error) {
+                   PeerResult& out, std::string& error, uint32_t start_seed) {
   out = PeerResult{};
   if (!(sdf_voxel_m >= 0.001 && sdf_voxel_m <= 10.0)) {
     error = "the distance-field voxel must be in [0.001, 10] m";
@@ -120,6 +121,8 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
   char field[48];
   std::snprintf(field, sizeof field, " (%g cm field)", 100.0 * sdf_voxel_m);
   out.label = std::to_string(substeps_per_60hz) + " x " + std::to_string(iterations) + field;
+  out.start_seed = start_seed;
+  if (start_seed > 0) out.label += ", start seed " + std::to_string(start_seed);
   out.take = take.name;
   out.rate_hz = take.rate_hz;
 
@@ -233,10 +236,22 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
   sb.m_cfg.kCHR = 1.0;
   sb.m_cfg.collisions = btSoftBody::fCollision::SDF_RS;
   sb.getCollisionShape()->setMargin(cloth.collision_margin_m);
+  // Start where Drape placed it on the first pose; with a seed, the free nodes all moved by one
+  // offset of kStartNoiseM in a direction drawn from the seed (a rigid shift: no edge between free
+  // nodes changes length, so the start adds no stretch of its own).
+  btVector3 offset(0, 0, 0);
+  if (start_seed > 0) {
+    std::mt19937 rng(start_seed);
+    std::normal_distribution<double> gauss(0.0, 1.0);
+    const btVector3 dir(static_cast<btScalar>(gauss(rng)), static_cast<btScalar>(gauss(rng)),
+                        static_cast<btScalar>(gauss(rng)));
+    offset = dir.normalized() * static_cast<btScalar>(kStartNoiseM);
+  }
   for (uint32_t k = 0; k < nv; ++k) {
     if (pinned[k]) sb.setMass(static_cast<int>(k), 0);
-    sb.m_nodes[static_cast<int>(k)].m_x = bt(x[k]);  // start where Drape placed it on the first pose
-    sb.m_nodes[static_cast<int>(k)].m_q = bt(x[k]);
+    const btVector3 at = pinned[k] ? bt(x[k]) : bt(x[k]) + offset;
+    sb.m_nodes[static_cast<int>(k)].m_x = at;
+    sb.m_nodes[static_cast<int>(k)].m_q = at;
   }
   w.world.addSoftBody(&sb);
   for (uint32_t k = 0; k < ne; ++k) {

@@ -48,6 +48,7 @@ struct Options {
   bool help = false;
   bool bullet = true;
   double bullet_field_m = bench::kBulletFieldM;  // the peer's distance-field voxel
+  int peer_spread = 0;  // extra Bullet 4 x 10 runs per peer take, each from another starting shirt
   bool plots = true;
   std::string out = "drape-bench-out";
   std::vector<TakeSpec> takes;
@@ -60,6 +61,7 @@ struct Options {
 const char* kHelp =
     "usage: drape-bench [--quick] [--out DIR] [--take PATH[@STRIDE]]... [--seconds S] [--repeats N]\n"
     "                   [--sweeps a,b,...] [--energy-seconds S] [--no-bullet] [--bullet-field M]\n"
+    "                   [--peer-spread N]\n"
     "                   [--no-plots]\n"
     "Sweeps Drape's speed/accuracy settings over real takes and writes, into DIR (default\n"
     "drape-bench-out): <sweep>.csv and <sweep>.png per sweep, bullet_peer.csv, summary.md.\n"
@@ -74,7 +76,10 @@ const char* kHelp =
     "  --energy-seconds S  free-hanging energy-drift run length (default 2, quick 0.5)\n"
     "  --no-bullet       skip the Bullet peer;  --no-plots  skip gnuplot\n"
     "  --bullet-field M  the Bullet peer's distance-field voxel in metres, [0.005, 1] (default 0.05;\n"
-    "                    a full run also runs 4 x 10 at Bullet's own 0.25 and at 0.02)\n";
+    "                    a full run also runs 4 x 10 at Bullet's own 0.25 and at 0.02)\n"
+    "  --peer-spread N   Bullet 4 x 10 N more times per peer take, its free nodes starting shifted\n"
+    "                    0.5 mm from where Drape placed them (seeds 1..N), [0, 20] (default 0):\n"
+    "                    the spread of Bullet's figures and how often Drape's are below them\n";
 
 bool parseNumber(const std::string& s, double lo, double hi, double& out) {
   char* end = nullptr;
@@ -126,6 +131,10 @@ bool parse(int argc, char** argv, Options& o, std::string& err) {
     } else if (a == "--repeats") {
       if (!value(v) || !parseNumber(v, 1, 100, d)) return err = "--repeats must be in [1, 100]", false;
       o.repeats = static_cast<int>(d);
+    } else if (a == "--peer-spread") {
+      if (!value(v) || !parseNumber(v, 0, 20, d) || d != std::floor(d))
+        return err = "--peer-spread must be a whole number in [0, 20]", false;
+      o.peer_spread = static_cast<int>(d);
     } else if (a == "--bullet-field") {
       if (!value(v) || !parseNumber(v, 0.005, 1, o.bullet_field_m))
         return err = "--bullet-field must be in [0.005, 1] (metres)", false;
@@ -386,8 +395,21 @@ int run(int argc, char** argv) {
                      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
         report.peers.push_back(p);
       }
+      // --peer-spread: Bullet 4 x 10 on the peer's field again from other starting shirts.
+      for (int seed = 1; seed <= opt.peer_spread; ++seed) {
+        PeerResult p;
+        if (!runBulletPeer(takes[ti], table1_target, 4, 10, f, p, err, static_cast<uint32_t>(seed))) {
+          std::fprintf(stderr, "drape-bench: error: Bullet peer: %s\n", err.c_str());
+          return kExitFailure;
+        }
+        std::fprintf(stderr, "drape-bench: Bullet %s on %s: stretch P99 %.2f %%, penetration P99 %.2f mm\n",
+                     p.label.c_str(), p.take.c_str(), 100.0 * p.bullet.stretch_p99, p.bullet.penetration_p99_mm);
+        report.spread.push_back(p);
+      }
     }
-    if (!writePeerCsv((fs::path(opt.out) / "bullet_peer.csv").string(), report.peers, err)) {
+    if (!writePeerCsv((fs::path(opt.out) / "bullet_peer.csv").string(), report.peers, err) ||
+        (!report.spread.empty() &&
+         !writePeerCsv((fs::path(opt.out) / "bullet_spread.csv").string(), report.spread, err))) {
       std::fprintf(stderr, "drape-bench: error: %s\n", err.c_str());
       return kExitFailure;
     }

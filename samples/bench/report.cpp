@@ -2,6 +2,7 @@
 
 #include "metrics.h"
 
+#include <algorithm>
 #include <cstdarg>
 #include <cstdio>
 #include <fstream>
@@ -44,6 +45,49 @@ const Row* defaultRow(const ReportInput& in, const std::string& take) {
     for (const Row& r : rs)
       if (r.take == take && r.setting.is_default) return &r;
   return nullptr;
+}
+
+// --peer-spread: per take, Bullet 4 x 10 (the peer's field) from its usual start and from the
+// seeds' starting shirts, against Drape's two settings (the same in every run: Drape's start is
+// not perturbed).
+void renderSpread(const ReportInput& in, std::string& o) {
+  std::vector<std::string> takes;
+  for (const PeerResult& p : in.spread)
+    if (std::find(takes.begin(), takes.end(), p.take) == takes.end()) takes.push_back(p.take);
+  if (takes.empty()) return;
+  appendf(o,
+          "\n## Bullet 4 x 10 over several starting shirts (`--peer-spread`)\n\n"
+          "Bullet's free nodes start shifted together by %.1f mm (a direction drawn per seed) from where Drape "
+          "placed them; seed 0 is the run above. Drape starts as above in every run.\n\n"
+          "| take | starts | Bullet stretch %% P99: min / median / max | Bullet penetration mm P99: min / median / "
+          "max | Drape's default: stretch %% P99, penetration mm, stretch below Bullet's | Drape at %s: the same |\n"
+          "|---|---|---|---|---|---|\n",
+          1000.0 * kStartNoiseM, lessStretchLabel().c_str());
+  for (const std::string& take : takes) {
+    std::vector<const PeerResult*> runs;
+    for (const PeerResult& p : in.peers)
+      if (p.take == take && p.substeps_per_60hz == 4 && p.iterations == 10 && p.sdf_voxel_m == in.peer_field_m)
+        runs.push_back(&p);
+    for (const PeerResult& p : in.spread)
+      if (p.take == take) runs.push_back(&p);
+    std::vector<double> stretch, pen;
+    for (const PeerResult* p : runs) {
+      stretch.push_back(100.0 * p->bullet.stretch_p99);
+      pen.push_back(p->bullet.penetration_p99_mm);
+    }
+    auto below = [&](const PeerSide& d) {
+      int n = 0;
+      for (const PeerResult* p : runs) n += d.stretch_p99 < p->bullet.stretch_p99 ? 1 : 0;
+      return n;
+    };
+    const PeerResult& first = *runs.front();
+    appendf(o, "| %s | %zu | %.2f / %.2f / %.2f | %.2f / %.2f / %.2f | %.2f, %.2f, in %d of %zu | %.2f, %.2f, in %d of %zu |\n",
+            take.c_str(), runs.size(), *std::min_element(stretch.begin(), stretch.end()), median(stretch),
+            *std::max_element(stretch.begin(), stretch.end()), *std::min_element(pen.begin(), pen.end()), median(pen),
+            *std::max_element(pen.begin(), pen.end()), 100.0 * first.drape.stretch_p99,
+            first.drape.penetration_p99_mm, below(first.drape), runs.size(), 100.0 * first.drape_less.stretch_p99,
+            first.drape_less.penetration_p99_mm, below(first.drape_less), runs.size());
+  }
 }
 
 }  // namespace
@@ -181,6 +225,8 @@ std::string renderReport(const ReportInput& in) {
       }
     }
   }
+
+  renderSpread(in, o);
 
   // NvCloth per simulated second.
   if (!in.takes.empty()) {
