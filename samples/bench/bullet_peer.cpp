@@ -72,14 +72,7 @@ struct GarmentMeters {
     stretch.addFrame(x);
     inside.push_back(countInsideEllipsoids(x, n, pinned, ellipsoids));
   }
-  void finish(PeerSide& side) const {
-    side.stretch_p99 = stretch.p99();
-    side.stretch_max = stretch.max();
-    side.penetration_p99_mm = pen.p99Mm();
-    side.penetration_max_mm = pen.maxMm();
-    side.deeper_than_2mm = pen.deeperThan2mmFraction();
-    side.inside_mean = mean(inside);
-  }
+  void finish(PeerSide& side) const { readErrors(stretch, pen, inside, side); }
 };
 
 // Frame i of the take into one Drape context: push, step, then its garment's vertices into x.
@@ -121,7 +114,6 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
   char field[48];
   std::snprintf(field, sizeof field, " (%g cm field)", 100.0 * sdf_voxel_m);
   out.label = std::to_string(substeps_per_60hz) + " x " + std::to_string(iterations) + field;
-  out.start_seed = start_seed;
   if (start_seed > 0) out.label += ", start seed " + std::to_string(start_seed);
   out.take = take.name;
   out.rate_hz = take.rate_hz;
@@ -237,7 +229,7 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
   sb.m_cfg.collisions = btSoftBody::fCollision::SDF_RS;
   sb.getCollisionShape()->setMargin(cloth.collision_margin_m);
   // Start where Drape placed it on the first pose; with a seed, the free nodes all moved by one
-  // offset of kStartNoiseM in a direction drawn from the seed (a rigid shift: no edge between free
+  // offset of kStartShiftM in a direction drawn from the seed (a rigid shift: no edge between free
   // nodes changes length, so the start adds no stretch of its own).
   btVector3 offset(0, 0, 0);
   if (start_seed > 0) {
@@ -245,7 +237,7 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
     std::normal_distribution<double> gauss(0.0, 1.0);
     const btVector3 dir(static_cast<btScalar>(gauss(rng)), static_cast<btScalar>(gauss(rng)),
                         static_cast<btScalar>(gauss(rng)));
-    offset = dir.normalized() * static_cast<btScalar>(kStartNoiseM);
+    offset = dir.normalized() * static_cast<btScalar>(kStartShiftM);
   }
   for (uint32_t k = 0; k < nv; ++k) {
     if (pinned[k]) sb.setMass(static_cast<int>(k), 0);

@@ -59,7 +59,6 @@ struct PeerResult {
   int substeps_per_60hz = 0;
   int iterations = 0;
   double sdf_voxel_m = 0;  // Bullet's distance-field voxel
-  uint32_t start_seed = 0; // 0: Bullet starts where Drape placed the garment; else shifted kStartNoiseM
   uint32_t particles = 0;
   // drape: the default setting, which drives Bullet; drape_less: kLessStretchLimit in
   // kLessStretchPasses passes, in its own context beside it.
@@ -70,14 +69,13 @@ struct PeerResult {
 // per seed) from where Drape placed them: a cloth replay with contacts is chaotic, so each seed is
 // another sample of what Bullet does on the take (docs/benchmarks.md, "Bullet over several
 // starting shirts"). A rigid shift, not noise per node: noise would stretch the edges at the start.
-constexpr double kStartNoiseM = 0.0005;
+constexpr double kStartShiftM = 0.0005;
 
 // True when this drape-bench was built with Bullet.
 bool bulletAvailable();
-// Runs one Bullet setting beside Drape's default one. start_seed > 0: Bullet's free nodes start
-// shifted by kStartNoiseM in a direction drawn from that seed (the label says so); Drape is
-// unchanged.
-// false + error on failure.
+// Runs one Bullet setting beside Drape's default (the driver) and its setting with less stretch.
+// start_seed > 0: Bullet's free nodes start shifted by kStartShiftM in a direction drawn from that
+// seed (the label says so); Drape is unchanged. false + error on failure.
 bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, int iterations, double sdf_voxel_m,
                    PeerResult& out, std::string& error, uint32_t start_seed = 0);
 

@@ -65,6 +65,18 @@ class StretchMeter {
   std::vector<double> rest_, samples_;
 };
 
+// A garment's error figures from its meters, into a PeerSide or a RunResult (the same field names):
+// stretch P99 and max, penetration P99, max and the share deeper than 2 mm, `inside` per frame's mean.
+template <class Out>
+void readErrors(const StretchMeter& stretch, const PenetrationMeter& pen, const std::vector<double>& inside, Out& out) {
+  out.stretch_p99 = stretch.p99();
+  out.stretch_max = stretch.max();
+  out.penetration_p99_mm = pen.p99Mm();
+  out.penetration_max_mm = pen.maxMm();
+  out.deeper_than_2mm = pen.deeperThan2mmFraction();
+  out.inside_mean = mean(inside);
+}
+
 // Vertices strictly inside (> 0.1 mm, as drape_garment_measure counts) any of the ellipsoids,
 // `skip` marking vertices to leave out (pinned ones).
 uint32_t countInsideEllipsoids(const drape_vec3* vertices, size_t count, const std::vector<uint8_t>& skip,

@@ -62,7 +62,7 @@ void renderSpread(const ReportInput& in, std::string& o) {
           "| take | starts | Bullet stretch %% P99: min / median / max | Bullet penetration mm P99: min / median / "
           "max | Drape's default: stretch %% P99, penetration mm, stretch below Bullet's | Drape at %s: the same |\n"
           "|---|---|---|---|---|---|\n",
-          1000.0 * kStartNoiseM, lessStretchLabel().c_str());
+          1000.0 * kStartShiftM, lessStretchLabel().c_str());
   for (const std::string& take : takes) {
     std::vector<const PeerResult*> runs;
     for (const PeerResult& p : in.peers)

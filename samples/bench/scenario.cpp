@@ -296,12 +296,7 @@ bool runDrape(const Take& take, const Setting& s, const RunOptions& o, RunResult
   }
   out.substeps_per_frame = median(substeps);
   if (o.measure) {
-    out.stretch_p99 = stretch.p99();
-    out.stretch_max = stretch.max();
-    out.penetration_p99_mm = pen.p99Mm();
-    out.penetration_max_mm = pen.maxMm();
-    out.deeper_than_2mm = pen.deeperThan2mmFraction();
-    out.inside_mean = mean(inside);
+    readErrors(stretch, pen, inside, out);
     out.openings_off = inside.empty() ? 0.0 : static_cast<double>(openings_off_frames) / static_cast<double>(inside.size());
   }
   return true;

@@ -347,7 +347,7 @@ void EllipsoidCollider::refreshQuick(int k) {
   q.radii2_sqrt = q.radii2.cwiseSqrt();
   q.inside_tol2 = s.inside_tol2;
   q.graze = s.graze;
-  // The swept test's rejection bound (Quick::sweep_keep, collision_batch.inc): with U0, U1 the
+  // The swept test's rejection bound (Quick::sweep_keep2, collision_batch.inc): with U0, U1 the
   // start and end to_unit, e1 = x1 - c1 and dx, dc the particle's and the centre's moves,
   // q1 - q0 = (U1 - U0) e1 + U0 (dx - dc), |e1| <= r_max |q1|: |q1 - q0| <= alpha |q1| +
   // gamma (|dx| + |dc|), alpha = |U1 - U0|_F r_max, gamma = |U0|_F. A path that came within the

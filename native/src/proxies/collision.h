@@ -161,9 +161,10 @@ class EllipsoidCollider {
     Eigen::Vector4f radii2_sqrt;          // sqrt of radii2 lane by lane (not the radii: rounding)
     float inside_tol2 = 1.0f, graze = 0.0f;
     // Pass 0's cheap rejection of the swept test (refreshQuick): a lane outside at the end whose
-    // |q1| sweep_keep > sweep_k + sweep_gamma |x1 - x0| + kSweepRelSlack |q1|^2 cannot have
-    // crossed the ellipsoid during the span. NaN: never rejects.
-    float sweep_keep2 = 0.0f, sweep_k = 0.0f, sweep_gamma = 0.0f;  // sweep_keep2: sweep_keep^2, 0 when not > 0
+    // |q1|^2 sweep_keep2 > (sweep_k + sweep_gamma |x1 - x0| + kSweepRelSlack |q1|^2)^2 cannot
+    // have crossed the ellipsoid during the span (sweep_keep2 = (1 - alpha)^2, 0 where 1 - alpha
+    // is not positive: never rejects; NaN never rejects either).
+    float sweep_keep2 = 0.0f, sweep_k = 0.0f, sweep_gamma = 0.0f;
   };
   // The rejection's slack in unit-space lengths: the swept test's float rounding is ~1e-6 of |q|^2.
   static constexpr double kSweepSlack = 1e-3;
