@@ -44,7 +44,8 @@ inline bool shape_allowed(__global const DrapeClShape* s, uint flags, uint mask)
   return !(flags & DRAPE_CL_GROUPED) || (s->group & mask) != 0u;
 }
 
-/* closestInsideFloat: Newton on the closest-point root for points just inside (|q|^2 >= 0.64). */
+/* closestInsideFloat: Newton on the closest-point root for points just inside (|q|^2 >= 0.64),
+   the first step the one exact for a sphere (native/src/proxies/collision.cpp). */
 inline bool closest_inside_float(float3 b, float3 q, float r2, float3* local_pt, float3* qc) {
   if (!(r2 >= 0.64f)) return false;
   const float3 e = sqrt(b);
@@ -56,7 +57,7 @@ inline bool closest_inside_float(float3 b, float3 q, float r2, float3* local_pt,
   float dF = -2.0f * (qq.x + qq.y + qq.z);
   for (int it = 0; it < 8; ++it) {
     if (F < 0.0f) hi = t; else lo = t;
-    float tn = dF < 0.0f ? t - F / dF : lo;
+    float tn = dF < 0.0f ? (it == 0 ? 2.0f * r2 * (1.0f - sqrt(r2)) / dF : t - F / dF) : lo;
     if (!(tn > lo && tn < hi)) tn = 0.5f * (lo + hi);
     t = tn;
     const float3 r = 1.0f / (b + t);
@@ -64,8 +65,9 @@ inline bool closest_inside_float(float3 b, float3 q, float r2, float3* local_pt,
     const float3 uu = u * u;
     F = uu.x + uu.y + uu.z - 1.0f;
     if (fabs(F) < 2e-6f) {
-      *local_pt = b * y * r;
-      *qc = y * r * e;
+      const float out = F < 0.0f ? 1.0f - F : 1.0f; /* just inside: out to just outside */
+      *local_pt = b * y * r * out;
+      *qc = y * r * e * out;
       return true;
     }
     const float3 uur = uu * r;

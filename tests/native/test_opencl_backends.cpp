@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <vector>
 
 namespace drape {
@@ -277,8 +278,11 @@ TEST(OpenClBackend, AutoKeepsSmallGarmentsOnTheCpu) {
 // apart; the yardstick is how far the CPU drifts from itself when every joint moves by 1 um,
 // alternately one way and the other, in every frame (sensor noise is ~1 mm; the device's rounding
 // differs in every step too, so a nudge of the first frame alone is no yardstick where the scene
-// is calm: it dies out). At the library's default stride for this resolution (885 particles:
-// every substep) and at every second substep. docs/opencl.md has the figures.
+// is calm: it dies out). Whether a nudge sets off one of the take's chaotic events (a fold that
+// flips, a particle that goes the other way round an ellipsoid) is chance, so the yardstick is
+// the furthest of three nudged runs, along x, y and z (one run alone was calm on one tree and
+// drifted 14x further on the next). At the library's default stride for this resolution
+// (885 particles: every substep) and at every second substep. docs/opencl.md has the figures.
 class OpenClParityByStride : public ::testing::TestWithParam<int> {};
 
 TEST_P(OpenClParityByStride, TShirtOnKinectTake) {
@@ -288,13 +292,20 @@ TEST_P(OpenClParityByStride, TShirtOnKinectTake) {
   std::string err;
   ASSERT_TRUE(readRecordingFile(path, 0, rec, err)) << err;
   constexpr int kFrames = 60;
-  Context cpu(test::defaultDesc()), gpu(test::defaultDesc()), nudged(test::defaultDesc());
+  constexpr int kNudges = 3;  // along x, y, z
+  Context cpu(test::defaultDesc()), gpu(test::defaultDesc());
+  std::vector<std::unique_ptr<Context>> nudged;
   GarmentSimParams params;
   params.xpbd.collision_stride = GetParam();
   GarmentSim* a = test::addTemplate(cpu, GarmentKind::TShirt, 1000, ClothSolverKind::Xpbd, params, err);
   GarmentSim* b = test::addTemplate(gpu, GarmentKind::TShirt, 1000, ClothSolverKind::Xpbd, params, err);
-  GarmentSim* c = test::addTemplate(nudged, GarmentKind::TShirt, 1000, ClothSolverKind::Xpbd, params, err);
-  ASSERT_TRUE(a && b && c) << err;
+  ASSERT_TRUE(a && b) << err;
+  std::vector<GarmentSim*> c;
+  for (int n = 0; n < kNudges; ++n) {
+    nudged.push_back(std::make_unique<Context>(test::defaultDesc()));
+    c.push_back(test::addTemplate(*nudged.back(), GarmentKind::TShirt, 1000, ClothSolverKind::Xpbd, params, err));
+    ASSERT_TRUE(c.back()) << err;
+  }
   ASSERT_LE(a->particleCount(), kCollideEverySubstepMaxParticles);  // stride 0: every substep here
   std::string why;
   ASSERT_TRUE(chooseBackend(gpu, DRAPE_BACKEND_OPENCL, why)) << why;
@@ -315,27 +326,37 @@ TEST_P(OpenClParityByStride, TShirtOnKinectTake) {
       last_rms = static_cast<float>(std::sqrt(frame2 / static_cast<double>(p.particleCount())));
     }
     double rms() const { return std::sqrt(sum2 / static_cast<double>(samples)); }
-  } device, self;
+  } device, self[kNudges];
   for (int f = 0; f < kFrames && f < static_cast<int>(rec.frames.size()); ++f) {
     const RecordingFrame& fr = rec.frames[static_cast<size_t>(f)];
     const float dt = static_cast<float>(fr.time_s - prev);
     prev = fr.time_s;
-    RecordingFrame moved_fr = fr;
-    for (auto& j : moved_fr.joints) j.position.x() += f % 2 ? -1e-6f : 1e-6f;
     ASSERT_EQ(test::pushAndStep(cpu, rec, fr, fr.time_s, dt, err), DRAPE_OK) << err;
     ASSERT_EQ(test::pushAndStep(gpu, rec, fr, fr.time_s, dt, err), DRAPE_OK) << err;
-    ASSERT_EQ(test::pushAndStep(nudged, rec, moved_fr, fr.time_s, dt, err), DRAPE_OK) << err;
     device.add(*a, *b);
-    self.add(*a, *c);
+    for (int n = 0; n < kNudges; ++n) {
+      RecordingFrame moved_fr = fr;
+      for (auto& j : moved_fr.joints) j.position[n] += f % 2 ? -1e-6f : 1e-6f;
+      ASSERT_EQ(test::pushAndStep(*nudged[static_cast<size_t>(n)], rec, moved_fr, fr.time_s, dt, err), DRAPE_OK)
+          << err;
+      self[n].add(*a, *c[static_cast<size_t>(n)]);
+    }
   }
+  const Diff* far = &self[0];  // the furthest nudged run, by RMS
+  for (const Diff& d : self) far = d.rms() > far->rms() ? &d : far;
+  float self_worst = 0.0f;
+  for (const Diff& d : self) self_worst = std::max(self_worst, d.worst);
   std::printf("[ figures  ] T-shirt %zu particles, collision_stride %d, %d frames of Ges01_wavehand, positions vs "
               "the CPU run (mm):\n"
               "[ figures  ]   OpenCL:                  RMS %.3f, max %.3f, last-frame RMS %.3f\n"
-              "[ figures  ]   CPU, joints +-1 um:      RMS %.3f, max %.3f, last-frame RMS %.3f\n",
-              a->particleCount(), GetParam(), kFrames, device.rms(), device.worst, device.last_rms, self.rms(),
-              self.worst, self.last_rms);
-  EXPECT_LT(device.rms(), 3.0 * self.rms() + 0.01);
-  EXPECT_LT(device.worst, 3.0f * self.worst + 0.1f);
+              "[ figures  ]   CPU, joints +-1 um in x: RMS %.3f, max %.3f, last-frame RMS %.3f\n"
+              "[ figures  ]   CPU, joints +-1 um in y: RMS %.3f, max %.3f, last-frame RMS %.3f\n"
+              "[ figures  ]   CPU, joints +-1 um in z: RMS %.3f, max %.3f, last-frame RMS %.3f\n",
+              a->particleCount(), GetParam(), kFrames, device.rms(), device.worst, device.last_rms, self[0].rms(),
+              self[0].worst, self[0].last_rms, self[1].rms(), self[1].worst, self[1].last_rms, self[2].rms(),
+              self[2].worst, self[2].last_rms);
+  EXPECT_LT(device.rms(), 3.0 * far->rms() + 0.01);
+  EXPECT_LT(device.worst, 3.0f * self_worst + 0.1f);
   EXPECT_LT(device.rms(), 15.0);  // absolute: the measured 4.9 mm (5.1 with the strain limit) plus a margin
 }
 
