@@ -44,10 +44,10 @@ inline bool shape_allowed(__global const DrapeClShape* s, uint flags, uint mask)
   return !(flags & DRAPE_CL_GROUPED) || (s->group & mask) != 0u;
 }
 
-/* closestInsideFloat: Newton on the closest-point root for points just inside (|q|^2 >= 0.64),
+/* closestInsideFloat: Newton on the closest-point root for points inside (|q|^2 >= 0.25),
    the first step the one exact for a sphere (native/src/proxies/collision.cpp). */
 inline bool closest_inside_float(float3 b, float3 q, float r2, float3* local_pt, float3* qc) {
-  if (!(r2 >= 0.64f)) return false;
+  if (!(r2 >= 0.25f)) return false;
   const float3 e = sqrt(b);
   const float3 y = e * q;
   const float3 a = y * e;

@@ -1018,12 +1018,26 @@ TEST(Collider, DegenerateInputsStayFinite) {
   EXPECT_EQ(col.collide(x.data(), nullptr, 1, CollisionParams{}).tests, 0u);
 }
 
+// Contacts with |q| in [lo, hi) of four ellipsoids (limb, flat torso ring, sphere, triaxial): the
+// collider's exact response against the reference closest point.
+void expectExactContactsMatchTheReference(float lo, float hi, const char* what);
+
 TEST(Collider, ExactShallowContactsMatchTheReference) {
   // Contacts with |q| in [0.8, 1) take the float Newton path of the collider (the double solver
   // only as fallback); the result must be the reference closest point: same distance to 1e-5 of
   // the largest radius (on g++'s old sample the worst of 20 000 points was 1.2e-7 m; on this
   // sample one point of the 3 cm-thin ellipsoid is 7.9e-7 m off, 6.6e-6 of its 0.12 m radius, all
   // others under 1.2e-7 m), on the surface, and never a longer push than the radial one.
+  expectExactContactsMatchTheReference(0.8f, 0.9999f, "shallow");
+}
+
+TEST(Collider, ExactDeeperContactsMatchTheReference) {
+  // |q| in [0.5, 0.8): the float Newton path too since 2026-12-01 (the double solver before; 75
+  // such contacts a frame on the default scene, each one particle at a time). The same bounds.
+  expectExactContactsMatchTheReference(0.5f, 0.8f, "deeper");
+}
+
+void expectExactContactsMatchTheReference(float lo, float hi, const char* what) {
   const Ellipsoid shapes[] = {
       makeEllipsoid(Vec3(0.1f, 1.2f, 0.3f), Vec3(0.05f, 0.15f, 0.05f),
                     Eigen::AngleAxisf(0.4f, Vec3(1, 2, 0).normalized()).toRotationMatrix()),
@@ -1032,7 +1046,7 @@ TEST(Collider, ExactShallowContactsMatchTheReference) {
       makeEllipsoid(Vec3(0.3f, 0.9f, -0.2f), Vec3(0.12f, 0.07f, 0.03f),
                     Eigen::AngleAxisf(1.1f, Vec3(0, 1, 1).normalized()).toRotationMatrix())};
   std::mt19937 rng(11);
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f), depth(0.8f, 0.9999f);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), depth(lo, hi);
   for (const Ellipsoid& e : shapes) {
     EllipsoidCollider col;
     col.setEllipsoids(&e, &e, 1, 0.0f);
@@ -1064,8 +1078,8 @@ TEST(Collider, ExactShallowContactsMatchTheReference) {
       EXPECT_NEAR(d, d_ref, 1e-5f * r_max) << "point " << i;
       EXPECT_LE(depthInside(e, exact[i].head<3>()), 1e-5f);
     }
-    std::printf("[ exact    ] radii %.3f %.3f %.3f: 5000 shallow contacts, worst |d - d_ref| = %.2g m\n",
-                e.radii.x(), e.radii.y(), e.radii.z(), worst);
+    std::printf("[ exact    ] radii %.3f %.3f %.3f: 5000 %s contacts, worst |d - d_ref| = %.2g m\n",
+                e.radii.x(), e.radii.y(), e.radii.z(), what, worst);
   }
 }
 
