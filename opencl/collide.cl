@@ -64,7 +64,7 @@ inline bool closest_inside_float(float3 b, float3 q, float r2, float3* local_pt,
     const float3 u = a * r;
     const float3 uu = u * u;
     F = uu.x + uu.y + uu.z - 1.0f;
-    if (fabs(F) < 2e-6f) {
+    if (fabs(F) < 1e-5f) {
       const float out = F < 0.0f ? 1.0f - F : 1.0f; /* just inside: out to just outside */
       *local_pt = b * y * r * out;
       *qc = y * r * e * out;

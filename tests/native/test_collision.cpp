@@ -1027,7 +1027,9 @@ TEST(Collider, ExactShallowContactsMatchTheReference) {
   // only as fallback); the result must be the reference closest point: same distance to 1e-5 of
   // the largest radius (on g++'s old sample the worst of 20 000 points was 1.2e-7 m; on this
   // sample one point of the 3 cm-thin ellipsoid is 7.9e-7 m off, 6.6e-6 of its 0.12 m radius, all
-  // others under 1.2e-7 m), on the surface, and never a longer push than the radial one.
+  // others under 1.2e-7 m; since the iteration stops at |F| < 1e-5 instead of 2e-6, the limb's
+  // worst is 5.1e-7 m and the flat ring's 4.1e-7), on the surface, and never a longer push than
+  // the radial one.
   expectExactContactsMatchTheReference(0.8f, 0.9999f, "shallow");
 }
 
