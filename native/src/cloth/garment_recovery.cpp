@@ -31,11 +31,12 @@ constexpr float kBurstOffM = 0.025f;
 constexpr float kCalmM = 0.010f;
 constexpr double kCalmEveryS = 0.2;
 
+// Centre and rotation only: a kept ellipsoid is read back through fromFrame, which refreshes it
+// (its to_unit, from_unit and bounds here are stale and never read).
 Ellipsoid toFrame(const Ellipsoid& e, const Mat3& f_t, const Vec3& c) {
   Ellipsoid out = e;
   out.centre = f_t * (e.centre - c);
   out.rotation = f_t * e.rotation;
-  out.refresh();
   return out;
 }
 
