@@ -242,8 +242,9 @@ TEST(ClothXpbd, WideProjectionMatchesEightLanesBitForBit) {
 // q + 8, q + 12 four consecutive particles at both ends (tethers: at the free end; what the
 // kernels load as one vector), within one colour group. On this grid 1 360 of the 3 174 distance
 // constraints are in quad batches (edges along a row pair up with their neighbours' only every
-// other one, in two colours), and most tethers.
-TEST(ClothXpbd, QuadBatchesHoldEveryConstraintOnceAndFourConsecutiveParticles) {
+// other one, in two colours), and most tethers; every batch of a pair run holds four octets of a
+// row's edges every other one (two 64-byte vectors each).
+TEST(ClothXpbd, QuadAndPairBatchesHoldEveryConstraintOnceAndConsecutiveParticles) {
   const GarmentTopology topology = square(24, false);
   const XpbdSolver s(topology);
   const uint32_t dummy = static_cast<uint32_t>(topology.particleCount());
@@ -297,8 +298,36 @@ TEST(ClothXpbd, QuadBatchesHoldEveryConstraintOnceAndFourConsecutiveParticles) {
       quad_entries += end - begin;
     }
     EXPECT_GE(static_cast<double>(quad_entries), c.min_quad_share * static_cast<double>(c.expected.size()));
+    // Pair runs (distance constraints only): lanes q, q + 4, q + 8, q + 12 hold (p, p + 1),
+    // (p + 2, p + 3), (p + 4, p + 5), (p + 6, p + 7), whole batches inside one colour group, none
+    // overlapping a quad run; wide_runs is both lists in order.
+    size_t pair_entries = 0;
+    for (const auto& [begin, end] : b.pair_runs) {
+      ASSERT_TRUE(c.quad_b) << "tethers make no pair batches";
+      ASSERT_LT(begin, end);
+      ASSERT_EQ(begin % 16, 0u);
+      ASSERT_EQ(end % 16, 0u);
+      const auto group = std::upper_bound(b.group_offsets.begin(), b.group_offsets.end(), begin);
+      ASSERT_NE(group, b.group_offsets.end());
+      EXPECT_LE(end, *group);
+      for (const auto& [qb, qe] : b.quad_runs) EXPECT_TRUE(end <= qb || qe <= begin);
+      for (uint32_t base = begin; base < end; base += 16) {
+        for (uint32_t q = 0; q < 4; ++q) {
+          for (uint32_t k = 0; k < 4; ++k) {
+            EXPECT_EQ(b.a[base + q + 4 * k], b.a[base + q] + 2 * k) << "entry " << base + q + 4 * k;
+            EXPECT_EQ(b.b[base + q + 4 * k], b.a[base + q] + 2 * k + 1) << "entry " << base + q + 4 * k;
+          }
+        }
+      }
+      pair_entries += end - begin;
+    }
+    ASSERT_EQ(b.wide_runs.size(), b.quad_runs.size() + b.pair_runs.size());
+    for (size_t r = 1; r < b.wide_runs.size(); ++r) EXPECT_LE(b.wide_runs[r - 1].end, b.wide_runs[r].begin);
+    std::printf("[ batches  ] %s: %zu constraints, %zu entries in quad batches, %zu in pair batches\n",
+                c.quad_b ? "distance" : "tethers", c.expected.size(), quad_entries, pair_entries);
   }
   EXPECT_FALSE(s.distanceBatches().quad_runs.empty());
+  EXPECT_FALSE(s.distanceBatches().pair_runs.empty());
 }
 
 TEST(ClothXpbd, TransformIsTheRigidMapOfEveryParticleBitForBit) {

@@ -42,11 +42,15 @@ double nsBetween(Clock::time_point a, Clock::time_point b) {
 // particles, as a template's rows of edges are), for q = 0..3; then the rest in the colour's order.
 // quad_b false (tethers, whose b is an anchor the kernels only read): a quad needs consecutive a
 // alone.
+// Then, with quad_b, `*pair_batches` batches whose lanes q, q + 4, q + 8, q + 12 hold (p, p + 1),
+// (p + 2, p + 3), (p + 4, p + 5), (p + 6, p + 7) (a "pair octet": a row's edges every other one,
+// which never form quads, consecutive edges sharing a particle).
 // Within a colour no two constraints share a particle that either writes, so this order gives the
 // same bits as any other; it lets the AVX-512 kernel load and store a quad's four particles as one
-// 64-byte vector (Batches::quad_runs).
+// 64-byte vector (Batches::quad_runs) and an octet's eight as two (Batches::pair_runs).
 std::vector<uint32_t> quadOrder(const DistanceConstraints& c, uint32_t g0, uint32_t g1, uint32_t particles,
-                                bool quad_b, std::vector<int32_t>& entry_of_a, size_t* quad_batches) {
+                                bool quad_b, std::vector<int32_t>& entry_of_a, size_t* quad_batches,
+                                size_t* pair_batches) {
   std::vector<uint32_t> by_a(g1 - g0);
   for (uint32_t k = g0; k < g1; ++k) by_a[k - g0] = k;
   std::sort(by_a.begin(), by_a.end(), [&](uint32_t i, uint32_t j) { return c.a[i] < c.a[j]; });
@@ -71,13 +75,38 @@ std::vector<uint32_t> quadOrder(const DistanceConstraints& c, uint32_t g0, uint3
       quads.push_back(ej);
     }
   }
-  for (uint32_t k = g0; k < g1; ++k) entry_of_a[c.a[k]] = -1;
   constexpr size_t kQuadsPerBatch = kLanes / 4;
   *quad_batches = quads.size() / 4 / kQuadsPerBatch;
   std::vector<uint32_t> order;
   order.reserve(g1 - g0);
   for (size_t batch = 0; batch < *quad_batches; ++batch) {
     const uint32_t* q = quads.data() + batch * kLanes;  // the batch's four quads
+    for (size_t lane = 0; lane < kLanes; ++lane) order.push_back(q[(lane % 4) * 4 + lane / 4]);
+  }
+  std::fill(used.begin(), used.end(), 0);
+  for (uint32_t k : order) used[k - g0] = 1;
+  // Pair octets among the rest (quads left over from a part batch among them).
+  std::vector<uint32_t> octets;  // four entries per octet, in order of a
+  for (uint32_t k : by_a) {
+    if (!quad_b || used[k - g0] || c.b[k] != c.a[k] + 1) continue;
+    uint32_t e[4] = {k, 0, 0, 0};
+    bool octet = true;
+    for (uint32_t j = 1; j < 4 && octet; ++j) {
+      const uint32_t aj = c.a[k] + 2 * j;
+      const int32_t ej = aj < particles ? entry_of_a[aj] : -1;
+      octet = ej >= 0 && !used[static_cast<uint32_t>(ej) - g0] && c.b[static_cast<uint32_t>(ej)] == aj + 1;
+      if (octet) e[j] = static_cast<uint32_t>(ej);
+    }
+    if (!octet) continue;
+    for (uint32_t ej : e) {
+      used[ej - g0] = 1;
+      octets.push_back(ej);
+    }
+  }
+  for (uint32_t k = g0; k < g1; ++k) entry_of_a[c.a[k]] = -1;
+  *pair_batches = octets.size() / kLanes;
+  for (size_t batch = 0; batch < *pair_batches; ++batch) {
+    const uint32_t* q = octets.data() + batch * kLanes;  // the batch's four octets
     for (size_t lane = 0; lane < kLanes; ++lane) order.push_back(q[(lane % 4) * 4 + lane / 4]);
   }
   std::fill(used.begin(), used.end(), 0);
@@ -89,25 +118,28 @@ std::vector<uint32_t> quadOrder(const DistanceConstraints& c, uint32_t g0, uint3
 
 // Appends the colour groups of `c` to `out`, each padded to a multiple of kLanes with dummy
 // constraints on particle `dummy` (= the particle count), each in quadOrder, with the entries of
-// its quad batches added to `quad_runs` ([begin, end) ranges).
+// its quad batches added to `quad_runs` and of its pair batches to `pair_runs` ([begin, end)).
 void appendPadded(const DistanceConstraints& c, bool quad_b, float compliance, uint32_t dummy,
                   std::vector<uint8_t>* kinds, uint8_t kind,
                   std::vector<uint32_t>& a, std::vector<uint32_t>& b, std::vector<float>& rest,
                   std::vector<float>& comp, std::vector<uint32_t>& offsets,
-                  std::vector<std::pair<uint32_t, uint32_t>>& quad_runs) {
+                  std::vector<std::pair<uint32_t, uint32_t>>& quad_runs,
+                  std::vector<std::pair<uint32_t, uint32_t>>& pair_runs) {
   std::vector<int32_t> entry_of_a(dummy, -1);
   for (size_t g = 0; g < c.colours(); ++g) {
-    size_t quad_batches = 0;
+    size_t quad_batches = 0, pair_batches = 0;
     const uint32_t start = static_cast<uint32_t>(a.size());
-    for (uint32_t k :
-         quadOrder(c, c.colour_offsets[g], c.colour_offsets[g + 1], dummy, quad_b, entry_of_a, &quad_batches)) {
+    for (uint32_t k : quadOrder(c, c.colour_offsets[g], c.colour_offsets[g + 1], dummy, quad_b, entry_of_a,
+                                &quad_batches, &pair_batches)) {
       a.push_back(c.a[k]);
       b.push_back(c.b[k]);
       rest.push_back(c.rest[k]);
       comp.push_back(compliance);
       if (kinds) kinds->push_back(kind);
     }
-    if (quad_batches > 0) quad_runs.emplace_back(start, static_cast<uint32_t>(start + quad_batches * kLanes));
+    const uint32_t pairs_at = static_cast<uint32_t>(start + quad_batches * kLanes);
+    if (quad_batches > 0) quad_runs.emplace_back(start, pairs_at);
+    if (pair_batches > 0) pair_runs.emplace_back(pairs_at, static_cast<uint32_t>(pairs_at + pair_batches * kLanes));
     while (a.size() % kLanes != 0) {
       a.push_back(dummy);
       b.push_back(dummy);
@@ -366,18 +398,57 @@ DRAPE_AVX512_FN __attribute__((always_inline)) inline __m512 rsqrtAsAvx(__m512 v
   return _mm512_castpd_ps(_mm512_insertf64x4(_mm512_castps_pd(_mm512_castps256_ps512(lo)), _mm256_castps_pd(hi), 1));
 }
 
+// A pair batch (Batches::pair_runs): lanes i, i + 4, i + 8, i + 12 hold (p, p + 1) ... (p + 6, p + 7)
+// from off[i] = p. The octet's eight particles are two 64-byte loads; one permute each picks the a
+// sides (p, p + 2, p + 4, p + 6: 128-bit groups 0 and 2 of both) and the b sides (groups 1 and 3).
+DRAPE_AVX512_FN __attribute__((always_inline)) inline void gatherPairs16(Vec4* x, const uint32_t* off, __m512 (&a)[4],
+                                                                         __m512 (&b)[4]) {
+  const __m512i even = _mm512_setr_epi32(0, 1, 2, 3, 8, 9, 10, 11, 16, 17, 18, 19, 24, 25, 26, 27);
+  const __m512i odd = _mm512_setr_epi32(4, 5, 6, 7, 12, 13, 14, 15, 20, 21, 22, 23, 28, 29, 30, 31);
+  for (int i = 0; i < 4; ++i) {
+    const float* p = at(x, off[i]);
+    const __m512 lo = _mm512_loadu_ps(p), hi = _mm512_loadu_ps(p + 16);
+    a[i] = _mm512_permutex2var_ps(lo, even, hi);
+    b[i] = _mm512_permutex2var_ps(lo, odd, hi);
+  }
+}
+// ... and back: the a and b sides interleaved again, two 64-byte stores per octet.
+DRAPE_AVX512_FN __attribute__((always_inline)) inline void scatterPairs16(Vec4* x, const uint32_t* off,
+                                                                          const __m512 (&a)[4], const __m512 (&b)[4]) {
+  const __m512i lo_idx = _mm512_setr_epi32(0, 1, 2, 3, 16, 17, 18, 19, 4, 5, 6, 7, 20, 21, 22, 23);
+  const __m512i hi_idx = _mm512_setr_epi32(8, 9, 10, 11, 24, 25, 26, 27, 12, 13, 14, 15, 28, 29, 30, 31);
+  for (int i = 0; i < 4; ++i) {
+    float* p = at(x, off[i]);
+    _mm512_storeu_ps(p, _mm512_permutex2var_ps(a[i], lo_idx, b[i]));
+    _mm512_storeu_ps(p + 16, _mm512_permutex2var_ps(a[i], hi_idx, b[i]));
+  }
+}
+
+// How a batch's particles are laid out: any (one 16-byte load per particle), a quad batch
+// (Batches::quad_runs) or a pair batch (Batches::pair_runs, distance constraints only).
+enum class Layout { Any, Quads, Pairs };
+
 // One batch of 16 constraints (entries A[0..16), ...).
-template <Kind kKind, bool kQuads>
+template <Kind kKind, Layout kLayout>
 DRAPE_AVX512_FN __attribute__((always_inline)) inline void projectBatch16(Vec4* x, const uint32_t* A,
                                                                           const uint32_t* B, const float* rest,
                                                                           const float* inv_w, __m512 vscale) {
+  static_assert(kLayout != Layout::Pairs || kKind != Kind::Tether, "tethers make no pair batches");
+  constexpr bool kQuads = kLayout == Layout::Quads;
   const __m512 zero = _mm512_setzero_ps();
   const __m512 tiny2 = _mm512_set1_ps(1e-18f), half = _mm512_set1_ps(0.5f);
   const __m512 three = _mm512_set1_ps(3.0f), one = _mm512_set1_ps(1.0f);
   const __m512 inf = _mm512_set1_ps(std::numeric_limits<float>::infinity());
   __m512 ax, ay, az, aw, bx, by, bz, bw;
-  gather16<kQuads>(x, A, ax, ay, az, aw);
-  gather16<kQuads && kKind != Kind::Tether>(x, B, bx, by, bz, bw);  // a tether's quad is its a side
+  if (kLayout == Layout::Pairs) {
+    __m512 ra[4], rb[4];
+    gatherPairs16(x, A, ra, rb);
+    simd::transpose4(ra[0], ra[1], ra[2], ra[3], ax, ay, az, aw);
+    simd::transpose4(rb[0], rb[1], rb[2], rb[3], bx, by, bz, bw);
+  } else {
+    gather16<kQuads>(x, A, ax, ay, az, aw);
+    gather16<kQuads && kKind != Kind::Tether>(x, B, bx, by, bz, bw);  // a tether's quad is its a side
+  }
   const __m512 dx = _mm512_sub_ps(ax, bx), dy = _mm512_sub_ps(ay, by), dz = _mm512_sub_ps(az, bz);
   const __m512 len2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)),
                                     _mm512_mul_ps(dz, dz));
@@ -401,6 +472,17 @@ DRAPE_AVX512_FN __attribute__((always_inline)) inline void projectBatch16(Vec4* 
   ax = _mm512_sub_ps(ax, _mm512_mul_ps(sa, dx));
   ay = _mm512_sub_ps(ay, _mm512_mul_ps(sa, dy));
   az = _mm512_sub_ps(az, _mm512_mul_ps(sa, dz));
+  if (kLayout == Layout::Pairs) {
+    const __m512 sb = _mm512_mul_ps(bw, s);
+    bx = _mm512_add_ps(bx, _mm512_mul_ps(sb, dx));
+    by = _mm512_add_ps(by, _mm512_mul_ps(sb, dy));
+    bz = _mm512_add_ps(bz, _mm512_mul_ps(sb, dz));
+    __m512 ra[4], rb[4];
+    simd::transpose4(ax, ay, az, aw, ra[0], ra[1], ra[2], ra[3]);
+    simd::transpose4(bx, by, bz, bw, rb[0], rb[1], rb[2], rb[3]);
+    scatterPairs16(x, A, ra, rb);
+    return;
+  }
   scatter16<kQuads>(x, A, ax, ay, az, aw);
   if (kKind != Kind::Tether) {
     const __m512 sb = _mm512_mul_ps(bw, s);
@@ -411,22 +493,28 @@ DRAPE_AVX512_FN __attribute__((always_inline)) inline void projectBatch16(Vec4* 
   }
 }
 
-// Entries [first, m) of the lists; quad_runs (Batches::quad_runs, sorted, each within one colour
-// group, so each lies wholly before or after `first`, a group's start) take the 64-byte path.
+// Entries [first, m) of the lists; the runs (Batches::wide_runs, sorted, each within one colour
+// group, so each lies wholly before or after `first`, a group's start) take the 64-byte paths.
 template <Kind kKind>
 DRAPE_AVX512_FN void projectBatchesAvx512(Vec4* x, const uint32_t* A, const uint32_t* B, const float* rest,
                                           const float* inv_w, size_t first, size_t m, float scale,
-                                          const std::pair<uint32_t, uint32_t>* quad_runs, size_t run_count) {
+                                          const XpbdSolver::WideRun* runs, size_t run_count) {
   const __m512 vscale = _mm512_set1_ps(scale);
   size_t k = first;
   for (size_t r = 0; r < run_count; ++r) {
-    if (quad_runs[r].first < first) continue;
-    for (; k < quad_runs[r].first; k += 16)
-      projectBatch16<kKind, false>(x, A + k, B + k, rest + k, inv_w + k, vscale);
-    for (; k < quad_runs[r].second; k += 16)
-      projectBatch16<kKind, true>(x, A + k, B + k, rest + k, inv_w + k, vscale);
+    if (runs[r].begin < first) continue;
+    for (; k < runs[r].begin; k += 16)
+      projectBatch16<kKind, Layout::Any>(x, A + k, B + k, rest + k, inv_w + k, vscale);
+    if (kKind != Kind::Tether && runs[r].kind == 2) {
+      for (; k < runs[r].end; k += 16)
+        projectBatch16<kKind == Kind::Tether ? Kind::Equality : kKind, Layout::Pairs>(x, A + k, B + k, rest + k,
+                                                                                      inv_w + k, vscale);
+    } else {
+      for (; k < runs[r].end; k += 16)
+        projectBatch16<kKind, Layout::Quads>(x, A + k, B + k, rest + k, inv_w + k, vscale);
+    }
   }
-  for (; k < m; k += 16) projectBatch16<kKind, false>(x, A + k, B + k, rest + k, inv_w + k, vscale);
+  for (; k < m; k += 16) projectBatch16<kKind, Layout::Any>(x, A + k, B + k, rest + k, inv_w + k, vscale);
 }
 #if !defined(__clang__)
 #pragma GCC diagnostic pop
@@ -440,18 +528,18 @@ template <Kind kKind>
 void project(Vec4* x, const std::vector<uint32_t>& A, const std::vector<uint32_t>& B,
              const std::vector<uint32_t>& A_off, const std::vector<uint32_t>& B_off, const float* rest,
              const float* inv_w, float scale, const std::vector<std::pair<uint32_t, uint32_t>>& quad_runs,
-             size_t first = 0, bool wide = true) {
+             const std::vector<XpbdSolver::WideRun>& wide_runs, size_t first = 0, bool wide = true) {
   const size_t m = A.size();
   if (first >= m) return;
 #if DRAPE_XPBD_AVX
   if (wide && cpuHasAvx512() && A_off.size() == m && B_off.size() == m)
     return projectBatchesAvx512<kKind>(x, A_off.data(), B_off.data(), rest, inv_w, first, m, scale,
-                                       quad_runs.data(), quad_runs.size());
+                                       wide_runs.data(), wide_runs.size());
   if (cpuHasAvx() && A_off.size() == m && B_off.size() == m)
     return projectBatchesAvx<kKind>(x, A_off.data(), B_off.data(), rest, inv_w, first, m, scale,
                                     quad_runs.data(), quad_runs.size());
 #endif
-  (void)A_off, (void)B_off, (void)wide, (void)quad_runs;
+  (void)A_off, (void)B_off, (void)wide, (void)quad_runs, (void)wide_runs;
   projectBatches<kKind>(x, A.data() + first, B.data() + first, rest + first, inv_w + first, m - first, scale);
 }
 
@@ -615,10 +703,19 @@ void XpbdSolver::buildBatches() {
   for (uint8_t k : kDistanceKindOrder) {
     if (k == 0) stretch_first_ = distance_.a.size();  // where the stretch colour groups start
     appendPadded(*kinds[k], true, 0.0f, dummy, &distance_kind_, k, distance_.a, distance_.b,
-                 distance_.rest, distance_.compliance, distance_.group_offsets, distance_.quad_runs);
+                 distance_.rest, distance_.compliance, distance_.group_offsets, distance_.quad_runs,
+                 distance_.pair_runs);
   }
   appendPadded(topology_.tether, false, 0.0f, dummy, nullptr, 0, tethers_.a, tethers_.b,
-               tethers_.rest, tethers_.compliance, tethers_.group_offsets, tethers_.quad_runs);
+               tethers_.rest, tethers_.compliance, tethers_.group_offsets, tethers_.quad_runs, tethers_.pair_runs);
+  // The AVX-512 kernel's walk: both kinds of run in order (each group's quads, then its octets).
+  for (Batches* bt : {&distance_, &tethers_}) {
+    bt->wide_runs.clear();
+    for (const auto& r : bt->quad_runs) bt->wide_runs.push_back({r.first, r.second, 1});
+    for (const auto& r : bt->pair_runs) bt->wide_runs.push_back({r.first, r.second, 2});
+    std::sort(bt->wide_runs.begin(), bt->wide_runs.end(),
+              [](const WideRun& u, const WideRun& v) { return u.begin < v.begin; });
+  }
   // The inverse masses are the topology's and never change (reset restores them), so their pair
   // sums are fixed with the batches; the dummy particle weighs nothing (w = 0).
   auto w = [&](uint32_t i) { return i < dummy ? topology_.inverse_mass[i] : 0.0f; };
@@ -857,10 +954,11 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
   }
   for (int it = 0; it < p.iterations; ++it) {  // 1 by default: the method's single pass
     project<Kind::Equality>(x, distance_.a, distance_.b, distance_.a_off, distance_.b_off,
-                            distance_.rest.data(), distance_.inv_w.data(), 1.0f, distance_.quad_runs, 0,
+                            distance_.rest.data(), distance_.inv_w.data(), 1.0f, distance_.quad_runs, distance_.wide_runs, 0,
                             wide_projection_);
     project<Kind::Tether>(x, tethers_.a, tethers_.b, tethers_.a_off, tethers_.b_off, tethers_.rest.data(),
-                          tethers_.inv_w.data(), p.tether_scale, tethers_.quad_runs, 0, wide_projection_);
+                          tethers_.inv_w.data(), p.tether_scale, tethers_.quad_runs, tethers_.wide_runs, 0,
+                          wide_projection_);
   }
   // The strain limit (XpbdParams::strain_limit) on the step's last substep, before collision so
   // that no particle is left inside an ellipsoid.
@@ -868,7 +966,8 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
   if (!predict_next && p.strain_limit > 0.0f) {
     for (int pass = 0; pass < p.strain_limit_passes; ++pass)
       project<Kind::Limit>(x, distance_.a, distance_.b, distance_.a_off, distance_.b_off, distance_.rest.data(),
-                           distance_.inv_w.data(), 1.0f + p.strain_limit, distance_.quad_runs, stretch_first_,
+                           distance_.inv_w.data(), 1.0f + p.strain_limit, distance_.quad_runs, distance_.wide_runs,
+                           stretch_first_,
                            wide_projection_);
   }
   // 3. Collision against the tracking ellipsoids.
