@@ -5,11 +5,15 @@
 #include "cloth_grid.h"
 #include "cloth/garment_topology.h"
 #include "cloth/xpbd_solver.h"
+#include "common/cpu.h"
 #include "proxies/collision.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <limits>
+#include <random>
 #include <set>
 #include <tuple>
 #include <vector>
@@ -139,6 +143,76 @@ TEST(CollideRims, BadIndicesAndNonFiniteEndsAreSkipped) {
   r.x[1].x() = NAN;
   EXPECT_EQ(c.collideRims(r.x.data(), 2, r.a.data(), r.b.data(), 1, CollisionParams{}, st), 0u);
   EXPECT_EQ(r.x[0], Eigen::Vector4f(-0.05f, 0.005f, 0.0f, 1.0f));
+}
+
+TEST(CollideRims, SixteenEdgesAtOnceMatchOneAtATimeBitForBit) {
+  // The screen that answers sixteen rim edges at once where no candidate may push them
+  // (rimScreenSixteen) against the scalar pass alone (batch16 off): positions bit for bit, the
+  // edges pushed, the tests and contacts counted. Loops of rim edges through six ellipsoids of
+  // four groups, ends at every depth (many pushed, many grazing near the push's threshold), mixed
+  // masks, pinned, gated and non-finite ends, bad indices.
+  if (!cpuHasAvx512()) GTEST_SKIP() << "this CPU has no AVX-512F: the screen never runs here";
+  const Ellipsoid shapes[] = {
+      rimTestEllipsoid(Vec3(0.0f, 0.0f, 0.0f), Vec3(0.03f, 0.03f, 0.2f)),
+      rimTestEllipsoid(Vec3(0.1f, 0.05f, 0.1f), Vec3(0.06f, 0.04f, 0.05f),
+                       Eigen::AngleAxisf(0.7f, Vec3(1, 1, 0).normalized()).toRotationMatrix()),
+      rimTestEllipsoid(Vec3(-0.1f, 0.0f, -0.1f), Vec3(0.05f, 0.05f, 0.05f)),
+      rimTestEllipsoid(Vec3(0.0f, -0.12f, 0.05f), Vec3(0.02f, 0.15f, 0.02f),
+                       Eigen::AngleAxisf(0.3f, Vec3(0, 0, 1)).toRotationMatrix()),
+      rimTestEllipsoid(Vec3(0.15f, -0.05f, -0.1f), Vec3(0.08f, 0.02f, 0.06f)),
+      rimTestEllipsoid(Vec3(-0.05f, 0.1f, 0.15f), Vec3(0.04f, 0.04f, 0.12f),
+                       Eigen::AngleAxisf(1.2f, Vec3(0, 1, 0)).toRotationMatrix())};
+  const std::vector<uint8_t> groups = {1, 2, 1, 4, 8, 2};
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-0.25f, 0.25f), unit(0.0f, 1.0f);
+  const size_t n = 600;
+  std::vector<Eigen::Vector4f> x(n);
+  std::vector<uint8_t> masks(n), gate(n);
+  for (size_t i = 0; i < n; ++i) {
+    const float px = u(rng), py = u(rng), pz = u(rng), w = unit(rng);
+    x[i] = Eigen::Vector4f(px, py, pz, w < 0.1f ? 0.0f : w < 0.5f ? 0.5f : 1.0f);
+    const float m = unit(rng);
+    masks[i] = m < 0.05f ? 0 : m < 0.6f ? 0xFF : m < 0.8f ? 3 : m < 0.9f ? 6 : 9;
+    gate[i] = unit(rng) < 0.95f ? 1 : 0;
+  }
+  x[17].y() = NAN;
+  x[300].x() = std::numeric_limits<float>::infinity();
+  // Rims: loops of 8 to 40 consecutive particles, closed, then a few bad edges.
+  std::vector<uint32_t> a, b;
+  for (uint32_t start = 0; start + 8 < n;) {
+    const uint32_t len = 8 + static_cast<uint32_t>(unit(rng) * 32.0f);
+    const uint32_t end = std::min<uint32_t>(start + len, static_cast<uint32_t>(n));
+    for (uint32_t i = start; i < end; ++i) {
+      a.push_back(i);
+      b.push_back(i + 1 < end ? i + 1 : start);
+    }
+    start = end;
+  }
+  a.insert(a.begin() + 40, {5, 7, 9});
+  b.insert(b.begin() + 40, {5, static_cast<uint32_t>(n) + 3, 10});
+  for (const bool gated : {false, true}) {
+    for (const bool grouped : {false, true}) {
+      EllipsoidCollider c;
+      c.setEllipsoids(shapes, shapes, 6, kMargin);
+      if (grouped) c.setGroups(groups, masks.data());
+      CollisionStats st[2];
+      size_t pushed[2];
+      std::vector<Eigen::Vector4f> out[2] = {x, x};
+      for (int wide = 0; wide < 2; ++wide) {
+        CollisionParams p;
+        p.batch16 = wide == 1;
+        pushed[wide] = c.collideRims(out[wide].data(), n, a.data(), b.data(), a.size(), p, st[wide],
+                                     gated ? gate.data() : nullptr);
+      }
+      EXPECT_EQ(std::memcmp(out[0].data(), out[1].data(), n * sizeof(Eigen::Vector4f)), 0) << gated << grouped;
+      EXPECT_EQ(pushed[0], pushed[1]);
+      EXPECT_EQ(st[0].tests, st[1].tests);
+      EXPECT_EQ(st[0].contacts, st[1].contacts);
+      EXPECT_GT(pushed[0], 20u) << "the scene pushes edges";
+      std::printf("[ rims     ] gated %d grouped %d: %zu edges, %zu pushed, %u tests\n", gated, grouped, a.size(),
+                  pushed[0], st[0].tests);
+    }
+  }
 }
 
 TEST(GarmentTopologyRims, TheRimsAreTheBoundaryEdgesColouredApart) {

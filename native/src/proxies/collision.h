@@ -226,6 +226,11 @@ class EllipsoidCollider {
                        const CollisionParams& p, bool grouped, CollisionStats& st) const;
   size_t collideSixteens(Eigen::Vector4f* positions, const Eigen::Vector4f* previous, size_t first, size_t count,
                          const CollisionParams& p, bool grouped, CollisionStats& st) const;
+  // collideRims' first look at sixteen rim edges [a, a + 16) at once (collision_rims.cpp): counts
+  // the candidate tests each edge would make and returns the first edge that a candidate may push
+  // (16 when none may: then the edges are done, nothing moved). -1 when the CPU lacks AVX-512F.
+  int rimScreenSixteen(const Eigen::Vector4f* positions, size_t count, const uint32_t* a, const uint32_t* b,
+                       bool use_grid, bool grouped, const uint8_t* active, CollisionStats& st) const;
   // contact() for the lanes of `lanes` of a batch against ellipsoid k, where each is inside
   // (discrete contact) and the response is Exact, all lanes at once: the same arithmetic in the
   // same order per lane. Returns the lanes it answered (their x updated, st.contacts counted); the
