@@ -278,15 +278,18 @@ TEST(ClothXpbd, QuadAndPairBatchesHoldEveryConstraintOnceAndConsecutiveParticles
     }
     std::sort(held.begin(), held.end());
     EXPECT_EQ(held, c.expected);
-    size_t quad_entries = 0;
-    for (const auto& [begin, end] : b.quad_runs) {
-      ASSERT_LT(begin, end);
-      ASSERT_EQ(begin % 16, 0u);
-      ASSERT_EQ(end % 16, 0u);
-      // Inside one colour group.
+    // A run: whole batches, inside one colour group.
+    const auto expectWholeBatchesInOneGroup = [&b](uint32_t begin, uint32_t end) {
+      EXPECT_LT(begin, end);
+      EXPECT_EQ(begin % 16, 0u);
+      EXPECT_EQ(end % 16, 0u);
       const auto group = std::upper_bound(b.group_offsets.begin(), b.group_offsets.end(), begin);
       ASSERT_NE(group, b.group_offsets.end());
       EXPECT_LE(end, *group);
+    };
+    size_t quad_entries = 0;
+    for (const auto& [begin, end] : b.quad_runs) {
+      expectWholeBatchesInOneGroup(begin, end);
       for (uint32_t base = begin; base < end; base += 16) {
         for (uint32_t q = 0; q < 4; ++q) {
           for (uint32_t k = 1; k < 4; ++k) {
@@ -304,12 +307,7 @@ TEST(ClothXpbd, QuadAndPairBatchesHoldEveryConstraintOnceAndConsecutiveParticles
     size_t pair_entries = 0;
     for (const auto& [begin, end] : b.pair_runs) {
       ASSERT_TRUE(c.quad_b) << "tethers make no pair batches";
-      ASSERT_LT(begin, end);
-      ASSERT_EQ(begin % 16, 0u);
-      ASSERT_EQ(end % 16, 0u);
-      const auto group = std::upper_bound(b.group_offsets.begin(), b.group_offsets.end(), begin);
-      ASSERT_NE(group, b.group_offsets.end());
-      EXPECT_LE(end, *group);
+      expectWholeBatchesInOneGroup(begin, end);
       for (const auto& [qb, qe] : b.quad_runs) EXPECT_TRUE(end <= qb || qe <= begin);
       for (uint32_t base = begin; base < end; base += 16) {
         for (uint32_t q = 0; q < 4; ++q) {
