@@ -426,21 +426,21 @@ DRAPE_AVX512_FN __attribute__((always_inline)) inline void scatterPairs16(Vec4* 
 
 // How a batch's particles are laid out: any (one 16-byte load per particle), a quad batch
 // (Batches::quad_runs) or a pair batch (Batches::pair_runs, distance constraints only).
-enum class Layout { Any, Quads, Pairs };
+enum class BatchLayout { Any, Quads, Pairs };
 
 // One batch of 16 constraints (entries A[0..16), ...).
-template <Kind kKind, Layout kLayout>
+template <Kind kKind, BatchLayout kLayout>
 DRAPE_AVX512_FN __attribute__((always_inline)) inline void projectBatch16(Vec4* x, const uint32_t* A,
                                                                           const uint32_t* B, const float* rest,
                                                                           const float* inv_w, __m512 vscale) {
-  static_assert(kLayout != Layout::Pairs || kKind != Kind::Tether, "tethers make no pair batches");
-  constexpr bool kQuads = kLayout == Layout::Quads;
+  static_assert(kLayout != BatchLayout::Pairs || kKind != Kind::Tether, "tethers make no pair batches");
+  constexpr bool kQuads = kLayout == BatchLayout::Quads;
   const __m512 zero = _mm512_setzero_ps();
   const __m512 tiny2 = _mm512_set1_ps(1e-18f), half = _mm512_set1_ps(0.5f);
   const __m512 three = _mm512_set1_ps(3.0f), one = _mm512_set1_ps(1.0f);
   const __m512 inf = _mm512_set1_ps(std::numeric_limits<float>::infinity());
   __m512 ax, ay, az, aw, bx, by, bz, bw;
-  if (kLayout == Layout::Pairs) {
+  if (kLayout == BatchLayout::Pairs) {
     __m512 ra[4], rb[4];
     gatherPairs16(x, A, ra, rb);
     simd::transpose4(ra[0], ra[1], ra[2], ra[3], ax, ay, az, aw);
@@ -472,7 +472,7 @@ DRAPE_AVX512_FN __attribute__((always_inline)) inline void projectBatch16(Vec4* 
   ax = _mm512_sub_ps(ax, _mm512_mul_ps(sa, dx));
   ay = _mm512_sub_ps(ay, _mm512_mul_ps(sa, dy));
   az = _mm512_sub_ps(az, _mm512_mul_ps(sa, dz));
-  if (kLayout == Layout::Pairs) {
+  if (kLayout == BatchLayout::Pairs) {
     const __m512 sb = _mm512_mul_ps(bw, s);
     bx = _mm512_add_ps(bx, _mm512_mul_ps(sb, dx));
     by = _mm512_add_ps(by, _mm512_mul_ps(sb, dy));
@@ -504,17 +504,18 @@ DRAPE_AVX512_FN void projectBatchesAvx512(Vec4* x, const uint32_t* A, const uint
   for (size_t r = 0; r < run_count; ++r) {
     if (runs[r].begin < first) continue;
     for (; k < runs[r].begin; k += 16)
-      projectBatch16<kKind, Layout::Any>(x, A + k, B + k, rest + k, inv_w + k, vscale);
-    if (kKind != Kind::Tether && runs[r].kind == 2) {
-      for (; k < runs[r].end; k += 16)
-        projectBatch16<kKind == Kind::Tether ? Kind::Equality : kKind, Layout::Pairs>(x, A + k, B + k, rest + k,
-                                                                                      inv_w + k, vscale);
-    } else {
-      for (; k < runs[r].end; k += 16)
-        projectBatch16<kKind, Layout::Quads>(x, A + k, B + k, rest + k, inv_w + k, vscale);
+      projectBatch16<kKind, BatchLayout::Any>(x, A + k, B + k, rest + k, inv_w + k, vscale);
+    if constexpr (kKind != Kind::Tether) {  // tethers make no pair runs
+      if (runs[r].kind == 2) {
+        for (; k < runs[r].end; k += 16)
+          projectBatch16<kKind, BatchLayout::Pairs>(x, A + k, B + k, rest + k, inv_w + k, vscale);
+        continue;
+      }
     }
+    for (; k < runs[r].end; k += 16)
+      projectBatch16<kKind, BatchLayout::Quads>(x, A + k, B + k, rest + k, inv_w + k, vscale);
   }
-  for (; k < m; k += 16) projectBatch16<kKind, Layout::Any>(x, A + k, B + k, rest + k, inv_w + k, vscale);
+  for (; k < m; k += 16) projectBatch16<kKind, BatchLayout::Any>(x, A + k, B + k, rest + k, inv_w + k, vscale);
 }
 #if !defined(__clang__)
 #pragma GCC diagnostic pop
@@ -707,7 +708,8 @@ void XpbdSolver::buildBatches() {
                  distance_.pair_runs);
   }
   appendPadded(topology_.tether, false, 0.0f, dummy, nullptr, 0, tethers_.a, tethers_.b,
-               tethers_.rest, tethers_.compliance, tethers_.group_offsets, tethers_.quad_runs, tethers_.pair_runs);
+               tethers_.rest, tethers_.compliance, tethers_.group_offsets, tethers_.quad_runs,
+               tethers_.pair_runs);
   // The AVX-512 kernel's walk: both kinds of run in order (each group's quads, then its octets).
   for (Batches* bt : {&distance_, &tethers_}) {
     bt->wide_runs.clear();
@@ -954,8 +956,8 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
   }
   for (int it = 0; it < p.iterations; ++it) {  // 1 by default: the method's single pass
     project<Kind::Equality>(x, distance_.a, distance_.b, distance_.a_off, distance_.b_off,
-                            distance_.rest.data(), distance_.inv_w.data(), 1.0f, distance_.quad_runs, distance_.wide_runs, 0,
-                            wide_projection_);
+                            distance_.rest.data(), distance_.inv_w.data(), 1.0f, distance_.quad_runs,
+                            distance_.wide_runs, 0, wide_projection_);
     project<Kind::Tether>(x, tethers_.a, tethers_.b, tethers_.a_off, tethers_.b_off, tethers_.rest.data(),
                           tethers_.inv_w.data(), p.tether_scale, tethers_.quad_runs, tethers_.wide_runs, 0,
                           wide_projection_);
@@ -967,8 +969,7 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
     for (int pass = 0; pass < p.strain_limit_passes; ++pass)
       project<Kind::Limit>(x, distance_.a, distance_.b, distance_.a_off, distance_.b_off, distance_.rest.data(),
                            distance_.inv_w.data(), 1.0f + p.strain_limit, distance_.quad_runs, distance_.wide_runs,
-                           stretch_first_,
-                           wide_projection_);
+                           stretch_first_, wide_projection_);
   }
   // 3. Collision against the tracking ellipsoids.
   if (collider != nullptr) {

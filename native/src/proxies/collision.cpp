@@ -51,12 +51,12 @@ inline void applyFriction(const Mat3& to_unit_end, const Vec3& c_end, const Mat3
 // Newton steps kept inside the bracket (bisection otherwise). The first step, from t = 0 (where
 // F = r2 - 1 and F' = -2 sum q_i^2 / b_i need no division), is the one that is exact for a
 // sphere: Newton on (F + 1)^(-1/2) - 1, linear in t when the b_i are equal, which gives
-// t1 = 2 r2 (1 - sqrt(r2)) / F'; Newton on F itself from there. On the default scene 59 % of the
-// contacts converge after that one step and 99 % after two (12 % and 82 % with Newton on F from
-// t = 0: docs/collision.md); converged when |F| < 1e-5 (2e-6 until 2026-12-01: the point is then
-// on the surface to 5e-6 of its radius, under 1 um, where the collider's promise is 10 um, and 75 %
-// of the lanes stop after the first step). False when it does not converge in 8 steps (near the medial
-// surface of a flat ellipsoid) or for deeper points: the caller then uses the double solver.
+// t1 = 2 r2 (1 - sqrt(r2)) / F'; Newton on F itself from there. Converged when |F| < 1e-5: the
+// point is then on the surface to 5e-6 of its radius, under 1 um, where the collider promises
+// 10 um. On the default scene 75 % of the contacts stop after the first step (at the tolerance
+// 2e-6 used until 2026-12-01, 59 %; and 12 % with Newton on F from t = 0: docs/collision.md).
+// False when it does not converge in 8 steps (near the medial surface of a flat ellipsoid) or for
+// deeper points: the caller then uses the double solver.
 // (Down to |q| = 0.5 the float answer is as close to the reference as near the surface, 1e-7 m:
 // Collider.ExactDeeperContactsMatchTheReference.)
 // e = sqrt(b) per lane (Quick::radii2_sqrt, computed once per ellipsoid and substep).

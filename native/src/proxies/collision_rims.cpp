@@ -122,7 +122,8 @@ size_t EllipsoidCollider::collideRims(Eigen::Vector4f* positions, size_t count, 
   // Sixteen edges at a time first: most edges touch nothing, and the screen answers those
   // together (their tests counted); from the first edge a candidate may push on, the scalar way
   // (a push moves particles the next edges share).
-  if (edges >= 16 && p.batch8 && p.batch16 && cpuHasAvx512() && shapes_.size() <= static_cast<size_t>(kMaxGridEllipsoids)) {
+  if (edges >= 16 && p.batch8 && p.batch16 && cpuHasAvx512() &&
+      shapes_.size() <= static_cast<size_t>(kMaxGridEllipsoids)) {
     for (; e + 16 <= edges; e += 16) {
       const int first = rimScreenSixteen(positions, count, a + e, b + e, use_grid, grouped, active, st);
       if (first < 0) break;
