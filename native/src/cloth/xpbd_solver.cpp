@@ -517,6 +517,25 @@ DRAPE_AVX512_FN void projectBatchesAvx512(Vec4* x, const uint32_t* A, const uint
   }
   for (; k < m; k += 16) projectBatch16<kKind, BatchLayout::Any>(x, A + k, B + k, rest + k, inv_w + k, vscale);
 }
+
+// inv_w[k] = 1 / (w_ab[k] + comp[k] inv_h2) (0 where that is not positive) for k in [first, end),
+// sixteen at a time: the scalar loop's operations (a product, then a sum, then the division),
+// so the same bits. XpbdSolver::substep runs it over the compliant runs whenever h changes (every
+// frame of a host whose frame times vary).
+DRAPE_AVX512_FN void refreshInvWAvx512(const float* w_ab, const float* comp, float* inv_w, uint32_t first,
+                                       uint32_t end, float inv_h2) {
+  const __m512 h = _mm512_set1_ps(inv_h2), zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f);
+  uint32_t k = first;
+  for (; k + 16 <= end; k += 16) {
+    const __m512 wsum = _mm512_add_ps(_mm512_loadu_ps(w_ab + k), _mm512_mul_ps(_mm512_loadu_ps(comp + k), h));
+    const __mmask16 pos = _mm512_cmp_ps_mask(wsum, zero, _CMP_GT_OQ);
+    _mm512_storeu_ps(inv_w + k, _mm512_maskz_div_ps(pos, one, wsum));
+  }
+  for (; k < end; ++k) {
+    const float wsum = w_ab[k] + comp[k] * inv_h2;
+    inv_w[k] = wsum > 0.0f ? 1.0f / wsum : 0.0f;
+  }
+}
 #if !defined(__clang__)
 #pragma GCC diagnostic pop
 #endif
@@ -947,6 +966,12 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
       const float* comp = b->compliance.data();
       float* inv_w = b->inv_w.data();
       for (const auto& run : b->compliant) {
+#if DRAPE_XPBD_AVX
+        if (wide_projection_ && cpuHasAvx512()) {
+          refreshInvWAvx512(w_ab, comp, inv_w, run.first, run.second, inv_h2);
+          continue;
+        }
+#endif
         for (uint32_t k = run.first; k < run.second; ++k) {
           const float wsum = w_ab[k] + comp[k] * inv_h2;
           inv_w[k] = wsum > 0.0f ? 1.0f / wsum : 0.0f;
