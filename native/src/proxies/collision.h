@@ -256,7 +256,15 @@ class EllipsoidCollider {
                float q0sq, bool inside, bool cont, bool friction, const Vec3& x0,
                const CollisionParams& p, Vec3& x, CollisionStats& st) const;
   Vec3 slideFromEntry(const Shape& s, const Vec3& qe, const Vec3& q1, Vec3& q_contact) const;
-  void escape(Vec3& x, ContactResponse mode, bool use_grid, const uint64_t* allowed, float max_escape,
+  // The ellipsoids containing a trapped particle (up to 8, in candidate order) and each one's
+  // response target: what escape() starts from (escapeIfInside gathers them).
+  static constexpr int kMaxEscapeCandidates = 8;
+  struct EscapeStart {
+    int m = 0;
+    int containing[kMaxEscapeCandidates];
+    Vec3 targets[kMaxEscapeCandidates];
+  };
+  void escape(Vec3& x, const EscapeStart& start, bool use_grid, const uint64_t* allowed, float max_escape,
               CollisionStats& stats) const;
 
   std::vector<Shape> shapes_;
