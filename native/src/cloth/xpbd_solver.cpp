@@ -47,7 +47,7 @@ double nsBetween(Clock::time_point a, Clock::time_point b) {
 // which never form quads, consecutive edges sharing a particle).
 // Within a colour no two constraints share a particle that either writes, so this order gives the
 // same bits as any other; it lets the AVX-512 kernel load and store a quad's four particles as one
-// 64-byte vector (Batches::quad_runs) and an octet's eight as two (Batches::pair_runs).
+// 64-byte vector (Batches::quad_runs) and an octet's eight as two (Batches::wide_runs).
 std::vector<uint32_t> quadOrder(const DistanceConstraints& c, uint32_t g0, uint32_t g1, uint32_t particles,
                                 bool quad_b, std::vector<int32_t>& entry_of_a, size_t* quad_batches,
                                 size_t* pair_batches) {
@@ -57,60 +57,50 @@ std::vector<uint32_t> quadOrder(const DistanceConstraints& c, uint32_t g0, uint3
   // A particle is `a` of at most one constraint of a colour (a writes), so `a` finds its entry.
   for (uint32_t k = g0; k < g1; ++k) entry_of_a[c.a[k]] = static_cast<int32_t>(k);
   std::vector<uint8_t> used(g1 - g0, 0);
-  std::vector<uint32_t> quads;  // four entries per quad, in order of a
-  for (uint32_t k : by_a) {
-    if (used[k - g0]) continue;
-    uint32_t e[4] = {k, 0, 0, 0};
-    bool quad = true;
-    for (uint32_t j = 1; j < 4 && quad; ++j) {
-      const uint32_t aj = c.a[k] + j;
-      const int32_t ej = aj < particles ? entry_of_a[aj] : -1;
-      quad = ej >= 0 && !used[static_cast<uint32_t>(ej) - g0] &&
-             (!quad_b || c.b[static_cast<uint32_t>(ej)] == c.b[k] + j);
-      if (quad) e[j] = static_cast<uint32_t>(ej);
+  // Runs of four free entries whose `a` step by `stride` from entry k's, in order of a, each entry
+  // of a run passing fits(entry, k, j) (j its place in the run): four entries per run.
+  const auto takeRuns = [&](uint32_t stride, auto fits) {
+    std::vector<uint32_t> runs;
+    for (uint32_t k : by_a) {
+      if (used[k - g0] || !fits(k, k, 0u)) continue;
+      uint32_t e[4] = {k, 0, 0, 0};
+      bool run = true;
+      for (uint32_t j = 1; j < 4 && run; ++j) {
+        const uint32_t aj = c.a[k] + stride * j;
+        const int32_t ej = aj < particles ? entry_of_a[aj] : -1;
+        run = ej >= 0 && !used[static_cast<uint32_t>(ej) - g0] && fits(static_cast<uint32_t>(ej), k, j);
+        if (run) e[j] = static_cast<uint32_t>(ej);
+      }
+      if (!run) continue;
+      for (uint32_t ej : e) {
+        used[ej - g0] = 1;
+        runs.push_back(ej);
+      }
     }
-    if (!quad) continue;
-    for (uint32_t ej : e) {
-      used[ej - g0] = 1;
-      quads.push_back(ej);
-    }
-  }
-  constexpr size_t kQuadsPerBatch = kLanes / 4;
-  *quad_batches = quads.size() / 4 / kQuadsPerBatch;
+    return runs;
+  };
   std::vector<uint32_t> order;
   order.reserve(g1 - g0);
-  for (size_t batch = 0; batch < *quad_batches; ++batch) {
-    const uint32_t* q = quads.data() + batch * kLanes;  // the batch's four quads
-    for (size_t lane = 0; lane < kLanes; ++lane) order.push_back(q[(lane % 4) * 4 + lane / 4]);
-  }
-  std::fill(used.begin(), used.end(), 0);
-  for (uint32_t k : order) used[k - g0] = 1;
+  // Every four runs a batch, run q in lanes q, q + 4, q + 8, q + 12; the runs of a part batch are
+  // freed again. Returns the batches.
+  const auto appendBatches = [&](const std::vector<uint32_t>& runs) {
+    const size_t batches = runs.size() / kLanes;
+    for (size_t batch = 0; batch < batches; ++batch) {
+      const uint32_t* q = runs.data() + batch * kLanes;  // the batch's four runs
+      for (size_t lane = 0; lane < kLanes; ++lane) order.push_back(q[(lane % 4) * 4 + lane / 4]);
+    }
+    for (size_t i = batches * kLanes; i < runs.size(); ++i) used[runs[i] - g0] = 0;
+    return batches;
+  };
+  *quad_batches = appendBatches(takeRuns(1, [&](uint32_t e, uint32_t k, uint32_t j) {
+    return !quad_b || c.b[e] == c.b[k] + j;  // (a, b), (a + 1, b + 1), ...
+  }));
   // Pair octets among the rest (quads left over from a part batch among them).
-  std::vector<uint32_t> octets;  // four entries per octet, in order of a
-  for (uint32_t k : by_a) {
-    if (!quad_b || used[k - g0] || c.b[k] != c.a[k] + 1) continue;
-    uint32_t e[4] = {k, 0, 0, 0};
-    bool octet = true;
-    for (uint32_t j = 1; j < 4 && octet; ++j) {
-      const uint32_t aj = c.a[k] + 2 * j;
-      const int32_t ej = aj < particles ? entry_of_a[aj] : -1;
-      octet = ej >= 0 && !used[static_cast<uint32_t>(ej) - g0] && c.b[static_cast<uint32_t>(ej)] == aj + 1;
-      if (octet) e[j] = static_cast<uint32_t>(ej);
-    }
-    if (!octet) continue;
-    for (uint32_t ej : e) {
-      used[ej - g0] = 1;
-      octets.push_back(ej);
-    }
-  }
+  *pair_batches = quad_b ? appendBatches(takeRuns(2, [&](uint32_t e, uint32_t, uint32_t) {
+                             return c.b[e] == c.a[e] + 1;  // (p, p + 1), (p + 2, p + 3), ...
+                           }))
+                         : 0;
   for (uint32_t k = g0; k < g1; ++k) entry_of_a[c.a[k]] = -1;
-  *pair_batches = octets.size() / kLanes;
-  for (size_t batch = 0; batch < *pair_batches; ++batch) {
-    const uint32_t* q = octets.data() + batch * kLanes;  // the batch's four octets
-    for (size_t lane = 0; lane < kLanes; ++lane) order.push_back(q[(lane % 4) * 4 + lane / 4]);
-  }
-  std::fill(used.begin(), used.end(), 0);
-  for (uint32_t k : order) used[k - g0] = 1;
   for (uint32_t k = g0; k < g1; ++k)
     if (!used[k - g0]) order.push_back(k);
   return order;
@@ -118,13 +108,14 @@ std::vector<uint32_t> quadOrder(const DistanceConstraints& c, uint32_t g0, uint3
 
 // Appends the colour groups of `c` to `out`, each padded to a multiple of kLanes with dummy
 // constraints on particle `dummy` (= the particle count), each in quadOrder, with the entries of
-// its quad batches added to `quad_runs` and of its pair batches to `pair_runs` ([begin, end)).
+// its quad batches added to `quad_runs` ([begin, end)) and its quad and pair batches to
+// `wide_runs`, in order.
 void appendPadded(const DistanceConstraints& c, bool quad_b, float compliance, uint32_t dummy,
                   std::vector<uint8_t>* kinds, uint8_t kind,
                   std::vector<uint32_t>& a, std::vector<uint32_t>& b, std::vector<float>& rest,
                   std::vector<float>& comp, std::vector<uint32_t>& offsets,
                   std::vector<std::pair<uint32_t, uint32_t>>& quad_runs,
-                  std::vector<std::pair<uint32_t, uint32_t>>& pair_runs) {
+                  std::vector<XpbdSolver::WideRun>& wide_runs) {
   std::vector<int32_t> entry_of_a(dummy, -1);
   for (size_t g = 0; g < c.colours(); ++g) {
     size_t quad_batches = 0, pair_batches = 0;
@@ -138,8 +129,13 @@ void appendPadded(const DistanceConstraints& c, bool quad_b, float compliance, u
       if (kinds) kinds->push_back(kind);
     }
     const uint32_t pairs_at = static_cast<uint32_t>(start + quad_batches * kLanes);
-    if (quad_batches > 0) quad_runs.emplace_back(start, pairs_at);
-    if (pair_batches > 0) pair_runs.emplace_back(pairs_at, static_cast<uint32_t>(pairs_at + pair_batches * kLanes));
+    if (quad_batches > 0) {
+      quad_runs.emplace_back(start, pairs_at);
+      wide_runs.push_back({start, pairs_at, XpbdSolver::RunKind::Quads});
+    }
+    if (pair_batches > 0)
+      wide_runs.push_back(
+          {pairs_at, static_cast<uint32_t>(pairs_at + pair_batches * kLanes), XpbdSolver::RunKind::Pairs});
     while (a.size() % kLanes != 0) {
       a.push_back(dummy);
       b.push_back(dummy);
@@ -398,7 +394,7 @@ DRAPE_AVX512_FN __attribute__((always_inline)) inline __m512 rsqrtAsAvx(__m512 v
   return _mm512_castpd_ps(_mm512_insertf64x4(_mm512_castps_pd(_mm512_castps256_ps512(lo)), _mm256_castps_pd(hi), 1));
 }
 
-// A pair batch (Batches::pair_runs): lanes i, i + 4, i + 8, i + 12 hold (p, p + 1) ... (p + 6, p + 7)
+// A pair batch (Batches::wide_runs, RunKind::Pairs): lanes i, i + 4, i + 8, i + 12 hold (p, p + 1) ... (p + 6, p + 7)
 // from off[i] = p. The octet's eight particles are two 64-byte loads; one permute each picks the a
 // sides (p, p + 2, p + 4, p + 6: 128-bit groups 0 and 2 of both) and the b sides (groups 1 and 3).
 DRAPE_AVX512_FN __attribute__((always_inline)) inline void gatherPairs16(Vec4* x, const uint32_t* off, __m512 (&a)[4],
@@ -425,7 +421,8 @@ DRAPE_AVX512_FN __attribute__((always_inline)) inline void scatterPairs16(Vec4* 
 }
 
 // How a batch's particles are laid out: any (one 16-byte load per particle), a quad batch
-// (Batches::quad_runs) or a pair batch (Batches::pair_runs, distance constraints only).
+// (Batches::quad_runs) or a pair batch (RunKind::Pairs in Batches::wide_runs, distance
+// constraints only).
 enum class BatchLayout { Any, Quads, Pairs };
 
 // One batch of 16 constraints (entries A[0..16), ...).
@@ -506,7 +503,7 @@ DRAPE_AVX512_FN void projectBatchesAvx512(Vec4* x, const uint32_t* A, const uint
     for (; k < runs[r].begin; k += 16)
       projectBatch16<kKind, BatchLayout::Any>(x, A + k, B + k, rest + k, inv_w + k, vscale);
     if constexpr (kKind != Kind::Tether) {  // tethers make no pair runs
-      if (runs[r].kind == 2) {
+      if (runs[r].kind == XpbdSolver::RunKind::Pairs) {
         for (; k < runs[r].end; k += 16)
           projectBatch16<kKind, BatchLayout::Pairs>(x, A + k, B + k, rest + k, inv_w + k, vscale);
         continue;
@@ -518,12 +515,12 @@ DRAPE_AVX512_FN void projectBatchesAvx512(Vec4* x, const uint32_t* A, const uint
   for (; k < m; k += 16) projectBatch16<kKind, BatchLayout::Any>(x, A + k, B + k, rest + k, inv_w + k, vscale);
 }
 
-// inv_w[k] = 1 / (w_ab[k] + comp[k] inv_h2) (0 where that is not positive) for k in [first, end),
-// sixteen at a time: the scalar loop's operations (a product, then a sum, then the division),
-// so the same bits. XpbdSolver::substep runs it over the compliant runs whenever h changes (every
-// frame of a host whose frame times vary).
-DRAPE_AVX512_FN void refreshInvWAvx512(const float* w_ab, const float* comp, float* inv_w, uint32_t first,
-                                       uint32_t end, float inv_h2) {
+// inv_w[k] = 1 / (w_ab[k] + comp[k] inv_h2) (0 where that is not positive) for whole sixteens of
+// [first, end): the scalar loop's operations (a product, then a sum, then the division), so the
+// same bits. Returns where it stopped (the caller's scalar loop does the rest). XpbdSolver::substep
+// runs it over the compliant runs whenever h changes (every frame of a host whose frame times vary).
+DRAPE_AVX512_FN uint32_t refreshInvWAvx512(const float* w_ab, const float* comp, float* inv_w, uint32_t first,
+                                           uint32_t end, float inv_h2) {
   const __m512 h = _mm512_set1_ps(inv_h2), zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f);
   uint32_t k = first;
   for (; k + 16 <= end; k += 16) {
@@ -531,10 +528,7 @@ DRAPE_AVX512_FN void refreshInvWAvx512(const float* w_ab, const float* comp, flo
     const __mmask16 pos = _mm512_cmp_ps_mask(wsum, zero, _CMP_GT_OQ);
     _mm512_storeu_ps(inv_w + k, _mm512_maskz_div_ps(pos, one, wsum));
   }
-  for (; k < end; ++k) {
-    const float wsum = w_ab[k] + comp[k] * inv_h2;
-    inv_w[k] = wsum > 0.0f ? 1.0f / wsum : 0.0f;
-  }
+  return k;
 }
 #if !defined(__clang__)
 #pragma GCC diagnostic pop
@@ -724,19 +718,11 @@ void XpbdSolver::buildBatches() {
     if (k == 0) stretch_first_ = distance_.a.size();  // where the stretch colour groups start
     appendPadded(*kinds[k], true, 0.0f, dummy, &distance_kind_, k, distance_.a, distance_.b,
                  distance_.rest, distance_.compliance, distance_.group_offsets, distance_.quad_runs,
-                 distance_.pair_runs);
+                 distance_.wide_runs);
   }
   appendPadded(topology_.tether, false, 0.0f, dummy, nullptr, 0, tethers_.a, tethers_.b,
                tethers_.rest, tethers_.compliance, tethers_.group_offsets, tethers_.quad_runs,
-               tethers_.pair_runs);
-  // The AVX-512 kernel's walk: both kinds of run in order (each group's quads, then its octets).
-  for (Batches* bt : {&distance_, &tethers_}) {
-    bt->wide_runs.clear();
-    for (const auto& r : bt->quad_runs) bt->wide_runs.push_back({r.first, r.second, 1});
-    for (const auto& r : bt->pair_runs) bt->wide_runs.push_back({r.first, r.second, 2});
-    std::sort(bt->wide_runs.begin(), bt->wide_runs.end(),
-              [](const WideRun& u, const WideRun& v) { return u.begin < v.begin; });
-  }
+               tethers_.wide_runs);
   // The inverse masses are the topology's and never change (reset restores them), so their pair
   // sums are fixed with the batches; the dummy particle weighs nothing (w = 0).
   auto w = [&](uint32_t i) { return i < dummy ? topology_.inverse_mass[i] : 0.0f; };
@@ -966,13 +952,11 @@ void XpbdSolver::substep(float h, float pin_t, const EllipsoidCollider* collider
       const float* comp = b->compliance.data();
       float* inv_w = b->inv_w.data();
       for (const auto& run : b->compliant) {
+        uint32_t k = run.first;
 #if DRAPE_XPBD_AVX
-        if (wide_projection_ && cpuHasAvx512()) {
-          refreshInvWAvx512(w_ab, comp, inv_w, run.first, run.second, inv_h2);
-          continue;
-        }
+        if (wide_projection_ && cpuHasAvx512()) k = refreshInvWAvx512(w_ab, comp, inv_w, k, run.second, inv_h2);
 #endif
-        for (uint32_t k = run.first; k < run.second; ++k) {
+        for (; k < run.second; ++k) {
           const float wsum = w_ab[k] + comp[k] * inv_h2;
           inv_w[k] = wsum > 0.0f ? 1.0f / wsum : 0.0f;
         }

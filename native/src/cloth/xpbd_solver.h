@@ -172,9 +172,11 @@ class XpbdSolver {
   // kLanes constraints shares no particle and needs no tail loop. Stretch, shear and bend are
   // one list (their colour groups concatenated in kDistanceKindOrder: the same Gauss–Seidel
   // order as three passes), each constraint carrying its kind's compliance.
+  // A run of whole batches the AVX-512 kernel moves as 64-byte vectors (Batches::wide_runs).
+  enum class RunKind : uint8_t { Quads, Pairs };
   struct WideRun {
     uint32_t begin, end;
-    uint8_t kind;
+    RunKind kind;
   };
   struct Batches {
     std::vector<uint32_t> a, b;
@@ -192,12 +194,11 @@ class XpbdSolver {
     // xpbd_solver.cpp): the AVX-512 kernel moves each such quad as one 64-byte load and store
     // instead of four 16-byte ones, the AVX kernel each half as one 32-byte one.
     std::vector<std::pair<uint32_t, uint32_t>> quad_runs;
-    // [begin, end) runs of whole batches whose lanes q, q + 4, q + 8, q + 12 hold (p, p + 1),
-    // (p + 2, p + 3), (p + 4, p + 5), (p + 6, p + 7) (quadOrder's pair octets: a row's edges every
-    // other one): the AVX-512 kernel moves each octet's eight particles as two 64-byte loads and
-    // stores. Distance constraints only.
-    std::vector<std::pair<uint32_t, uint32_t>> pair_runs;
-    // Both in order (kind 1 quads, 2 pair octets): what the AVX-512 kernel walks.
+    // What the AVX-512 kernel walks, in order: the quad runs (RunKind::Quads) and, after each
+    // group's, runs of whole batches whose lanes q, q + 4, q + 8, q + 12 hold (p, p + 1),
+    // (p + 2, p + 3), (p + 4, p + 5), (p + 6, p + 7) (RunKind::Pairs: quadOrder's pair octets, a
+    // row's edges every other one; distance constraints only), each octet's eight particles moved
+    // as two 64-byte loads and stores.
     std::vector<WideRun> wide_runs;
   };
   // The lists as the kernels run them (tests check their layout).

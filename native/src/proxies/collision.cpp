@@ -389,16 +389,18 @@ void EllipsoidCollider::forCandidates(const Vec3& lo, const Vec3& hi, bool use_g
   if (gather(lo, hi, use_grid, allowed, c)) iterate(c, f);
 }
 
+inline bool EllipsoidCollider::holdsBeyondTolerance(const Quick& qk, const Vec4& x4, uint32_t& tests) {
+  if (!contains4(qk.end_min, qk.end_max, x4)) return false;
+  ++tests;
+  return mulq(qk.end_u, x4 - qk.end_c).squaredNorm() < qk.inside_tol2;
+}
+
 int EllipsoidCollider::firstContaining(const Vec3& x, bool use_grid, const uint64_t* allowed,
                                        CollisionStats& st) const {
   int found = -1;
+  const Vec4 x4 = lift(x);
   forCandidates(x, x, use_grid, allowed, [&](int k) {
-    if (found >= 0) return;
-    const Quick& qk = quick_[static_cast<size_t>(k)];
-    const Vec4 x4 = lift(x);
-    if (!contains4(qk.end_min, qk.end_max, x4)) return;
-    ++st.tests;
-    if (mulq(qk.end_u, x4 - qk.end_c).squaredNorm() < qk.inside_tol2) found = k;
+    if (found < 0 && holdsBeyondTolerance(quick_[static_cast<size_t>(k)], x4, st.tests)) found = k;
   });
   return found;
 }
@@ -635,11 +637,7 @@ void EllipsoidCollider::escapeIfInside(Vec3& x, const CollisionParams& p, bool u
   EscapeStart start;
   const Vec4 x4 = lift(x);
   forCandidates(x, x, use_grid, allowed, [&](int k) {
-    const Quick& qk = quick_[static_cast<size_t>(k)];
-    if (found < 0 && contains4(qk.end_min, qk.end_max, x4)) {
-      ++tests_first;
-      if (mulq(qk.end_u, x4 - qk.end_c).squaredNorm() < qk.inside_tol2) found = k;
-    }
+    if (found < 0 && holdsBeyondTolerance(quick_[static_cast<size_t>(k)], x4, tests_first)) found = k;
     if (start.m == kMaxEscapeCandidates) return;
     const Shape& s = shapes_[static_cast<size_t>(k)];
     if (!containsPoint(s.end_min, s.end_max, x)) return;

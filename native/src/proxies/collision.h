@@ -228,7 +228,7 @@ class EllipsoidCollider {
                          const CollisionParams& p, bool grouped, CollisionStats& st) const;
   // collideRims' first look at sixteen rim edges [a, a + 16) at once (collision_rims.cpp): counts
   // the candidate tests each edge would make and returns the first edge that a candidate may push
-  // (16 when none may: then the edges are done, nothing moved). -1 when the CPU lacks AVX-512F.
+  // (16 when none may: then the edges are done, nothing moved). Only where cpuHasAvx512().
   int rimScreenSixteen(const Eigen::Vector4f* positions, size_t count, const uint32_t* a, const uint32_t* b,
                        bool use_grid, bool grouped, const uint8_t* active, CollisionStats& st) const;
   // contact() for the lanes of `lanes` of a batch against ellipsoid k, where each is inside
@@ -256,6 +256,10 @@ class EllipsoidCollider {
                float q0sq, bool inside, bool cont, bool friction, const Vec3& x0,
                const CollisionParams& p, Vec3& x, CollisionStats& st) const;
   Vec3 slideFromEntry(const Shape& s, const Vec3& qe, const Vec3& q1, Vec3& q_contact) const;
+  // Whether x4 is inside qk's end ellipsoid by more than the tolerance, its box first (a test
+  // counted in `tests` when the box holds x4): firstContaining's question, which escapeIfInside
+  // asks too and must answer the same.
+  static bool holdsBeyondTolerance(const Quick& qk, const Eigen::Vector4f& x4, uint32_t& tests);
   // The ellipsoids containing a trapped particle (up to 8, in candidate order) and each one's
   // response target: what escape() starts from (escapeIfInside gathers them).
   static constexpr int kMaxEscapeCandidates = 8;

@@ -14,7 +14,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 
 namespace drape {
 using namespace collision_internal;
@@ -32,6 +31,21 @@ constexpr float kRimEndT = 0.02f;
 // An ellipsoid whose longest radius is this many times its middle one is a limb's (or a long
 // torso segment's): rims are pushed across its long axis, not along it.
 constexpr float kLimbElongation = 1.5f;
+
+// Whether rim edge (ia, ib) takes part at all (its ends in range and distinct, both gated on,
+// not both pinned, finite), and the collision mask its ends share (both may touch; 0xFF without
+// groups: particle_masks null): the scalar pass and the sixteen-edge screen skip the same edges.
+bool rimEdgeTakesPart(const Eigen::Vector4f* positions, size_t count, uint32_t ia, uint32_t ib,
+                      const uint8_t* active, const uint8_t* particle_masks, uint8_t& mask) {
+  if (ia >= count || ib >= count || ia == ib) return false;
+  if (active && !(active[ia] && active[ib])) return false;
+  const Eigen::Vector4f& pa = positions[ia];
+  const Eigen::Vector4f& pb = positions[ib];
+  if (!(pa.w() > 0.0f) && !(pb.w() > 0.0f)) return false;
+  if (!pa.head<3>().allFinite() || !pb.head<3>().allFinite()) return false;
+  mask = particle_masks ? static_cast<uint8_t>(particle_masks[ia] & particle_masks[ib]) : 0xFF;
+  return mask != 0;
+}
 }  // namespace
 
 size_t EllipsoidCollider::collideRims(Eigen::Vector4f* positions, size_t count, const uint32_t* a,
@@ -44,16 +58,12 @@ size_t EllipsoidCollider::collideRims(Eigen::Vector4f* positions, size_t count, 
   // One edge the scalar way; true when it was pushed.
   const auto edge = [&](size_t e) {
     const uint32_t ia = a[e], ib = b[e];
-    if (ia >= count || ib >= count || ia == ib) return false;
-    if (active && !(active[ia] && active[ib])) return false;
+    // The ellipsoids both particles may touch: a sleeve's cuff meets the arm, not the torso.
+    uint8_t mask = 0;
+    if (!rimEdgeTakesPart(positions, count, ia, ib, active, grouped ? particle_masks_ : nullptr, mask)) return false;
     Eigen::Vector4f& pa = positions[ia];
     Eigen::Vector4f& pb = positions[ib];
     const float wa = pa.w() > 0.0f ? pa.w() : 0.0f, wb = pb.w() > 0.0f ? pb.w() : 0.0f;
-    if (wa == 0.0f && wb == 0.0f) return false;
-    if (!pa.head<3>().allFinite() || !pb.head<3>().allFinite()) return false;
-    // The ellipsoids both particles may touch: a sleeve's cuff meets the arm, not the torso.
-    const uint8_t mask = grouped ? static_cast<uint8_t>(particle_masks_[ia] & particle_masks_[ib]) : 0xFF;
-    if (grouped && mask == 0) return false;
     const uint64_t* allowed = grouped ? allowedRow(mask) : nullptr;
     Vec3 xa = pa.head<3>(), xb = pb.head<3>();
     Candidates c;
@@ -126,7 +136,6 @@ size_t EllipsoidCollider::collideRims(Eigen::Vector4f* positions, size_t count, 
       shapes_.size() <= static_cast<size_t>(kMaxGridEllipsoids)) {
     for (; e + 16 <= edges; e += 16) {
       const int first = rimScreenSixteen(positions, count, a + e, b + e, use_grid, grouped, active, st);
-      if (first < 0) break;
       for (size_t j = static_cast<size_t>(first); j < 16; ++j) pushed += edge(e + j) ? 1 : 0;
     }
   }
@@ -160,22 +169,15 @@ DRAPE_LANES16_TARGET int EllipsoidCollider::rimScreenSixteen(const Eigen::Vector
                                                              bool grouped, const uint8_t* active,
                                                              CollisionStats& st) const {
   using namespace collision_lanes::lanes16;
-  if (!cpuHasAvx512()) return -1;
   alignas(64) float ax[kLanes], ay[kLanes], az[kLanes], bx[kLanes], by[kLanes], bz[kLanes];
   LaneBytes masks{};
   int on = 0;
   for (int j = 0; j < kLanes; ++j) {
     ax[j] = ay[j] = az[j] = bx[j] = by[j] = bz[j] = 0.0f;
-    const uint32_t ia = a[j], ib = b[j];
-    if (ia >= count || ib >= count || ia == ib) continue;
-    if (active && !(active[ia] && active[ib])) continue;
-    const Eigen::Vector4f& pa = positions[ia];
-    const Eigen::Vector4f& pb = positions[ib];
-    if (!(pa.w() > 0.0f) && !(pb.w() > 0.0f)) continue;
-    if (!pa.head<3>().allFinite() || !pb.head<3>().allFinite()) continue;
-    const uint8_t mask = grouped ? static_cast<uint8_t>(particle_masks_[ia] & particle_masks_[ib]) : 0xFF;
-    if (mask == 0) continue;
-    masks.b[j] = mask;
+    if (!rimEdgeTakesPart(positions, count, a[j], b[j], active, grouped ? particle_masks_ : nullptr, masks.b[j]))
+      continue;
+    const Eigen::Vector4f& pa = positions[a[j]];
+    const Eigen::Vector4f& pb = positions[b[j]];
     ax[j] = pa.x(), ay[j] = pa.y(), az[j] = pa.z();
     bx[j] = pb.x(), by[j] = pb.y(), bz[j] = pb.z();
     on |= 1 << j;
