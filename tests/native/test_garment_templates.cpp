@@ -86,9 +86,10 @@ class GarmentTemplate : public testing::TestWithParam<Case> {
 };
 
 TEST_P(GarmentTemplate, ParticleCountNearTarget) {
+  // Within 1 % before the weld, which takes a few seam vertices (up to 1.6 % seen on trousers).
   const double n = static_cast<double>(mesh_.positions.size()), t = GetParam().target;
-  EXPECT_GE(n, 0.85 * t);
-  EXPECT_LE(n, 1.15 * t);
+  EXPECT_GE(n, 0.975 * t);
+  EXPECT_LE(n, 1.02 * t);
 }
 
 TEST_P(GarmentTemplate, ValidManifoldWithBoundary) {
@@ -205,6 +206,51 @@ std::vector<Case> allCases() {
 }
 
 INSTANTIATE_TEST_SUITE_P(Kinds, GarmentTemplate, testing::ValuesIn(allCases()), caseName);
+
+// Every resolution, not only the two above: on the heavy body the trousers' leg tubes pass within
+// the weld's tolerance of the crotch bridge at some counts (1 244-1 540, 2 021-2 058, 3 094-3 168
+// of a sweep in steps of 37), and the weld folded the two legs' triangles over a bridge segment
+// into one triangle wound both ways: an edge of four triangles (weldShortEdges). The count is
+// also checked here, over the range where the resolution can reach it.
+TEST(GarmentTemplateResolution, EveryCountIsAConsistentManifoldNearTheTarget) {
+  const int step = drape::test::kSanitizedBuild ? 211 : 37;
+  int cases = 0;
+  for (GarmentKind kind : {GarmentKind::TShirt, GarmentKind::Skirt, GarmentKind::Trousers, GarmentKind::LongSleeve,
+                           GarmentKind::Dress}) {
+    for (bool heavy : {false, true}) {
+      for (int target = 800; target <= 4000; target += step) {
+        GarmentTemplateParams p;
+        p.kind = kind;
+        p.target_particles = target;
+        GarmentMesh m;
+        std::string err;
+        const std::string name = std::string(garmentKindName(kind)) + (heavy ? " heavy " : " thin ") + std::to_string(target);
+        ASSERT_TRUE(makeGarmentTemplate((heavy ? heavyBody() : thinBody()).model, p, m, err)) << name << ": " << err;
+        std::map<std::pair<uint32_t, uint32_t>, int> directed, undirected;
+        for (size_t t = 0; t < m.indices.size(); t += 3) {
+          for (size_t k = 0; k < 3; ++k) {
+            const uint32_t u = m.indices[t + k], v = m.indices[t + (k + 1) % 3];
+            ++directed[{u, v}];
+            ++undirected[{std::min(u, v), std::max(u, v)}];
+          }
+        }
+        int shared = 0, twice = 0;
+        for (const auto& [e, n] : undirected) shared += n > 2;
+        for (const auto& [e, n] : directed) twice += n != 1;
+        EXPECT_EQ(shared, 0) << name << ": edges in more than two triangles";
+        EXPECT_EQ(twice, 0) << name << ": a directed edge used twice";
+        // Within 1 % before the weld where a ring's worth of points allows it (a skirt's ring is
+        // 56-72 points: 7-9 % of 800); the weld then takes up to 4 % (the trousers' crotch).
+        const double n = static_cast<double>(m.positions.size());
+        const double below = target < 1000 ? 0.9 : 0.955, above = target < 1000 ? 1.1 : 1.025;
+        EXPECT_GE(n, below * target) << name;
+        EXPECT_LE(n, above * target) << name;
+        ++cases;
+      }
+    }
+  }
+  EXPECT_GT(cases, 40);
+}
 
 TEST(GarmentTemplateInput, BadParamsRejectedAndOutputUntouched) {
   const Body& b = thinBody();
