@@ -37,6 +37,7 @@ struct PeerSide {
   std::vector<double> cpu_ms;
   double stretch_p99 = 0, stretch_max = 0;
   double penetration_p99_mm = 0, penetration_max_mm = 0, deeper_than_2mm = 0;
+  double in_body = 0;      // vertex-frames inside the body mesh at any depth
   double inside_mean = 0;  // free vertices inside any tracking ellipsoid, per frame
   bool finite = true;
 };

@@ -190,6 +190,7 @@ struct Runner {
     r.pen_p99_mm = measured.penetration_p99_mm;
     r.pen_max_mm = measured.penetration_max_mm;
     r.deeper_than_2mm = measured.deeper_than_2mm;
+    r.in_body = measured.in_body;
     r.inside_mean = measured.inside_mean;
     r.inside_max = measured.inside_max;
     r.openings_off = measured.openings_off;

@@ -48,6 +48,7 @@ void PenetrationMeter::addFrame(const BodySurface& body, const drape_vec3* verti
     const double depth = body.depthMm(vertices[i]);
     depth_mm_.push_back(depth);
     if (depth > 2.0) ++deep_;
+    if (depth > 0.0) ++inside_;
   }
 }
 
@@ -55,6 +56,9 @@ double PenetrationMeter::p99Mm() const { return percentile(depth_mm_, 99.0); }
 double PenetrationMeter::maxMm() const { return maximum(depth_mm_); }
 double PenetrationMeter::deeperThan2mmFraction() const {
   return depth_mm_.empty() ? kNaN : static_cast<double>(deep_) / static_cast<double>(depth_mm_.size());
+}
+double PenetrationMeter::insideFraction() const {
+  return depth_mm_.empty() ? kNaN : static_cast<double>(inside_) / static_cast<double>(depth_mm_.size());
 }
 
 void StretchMeter::setMesh(const std::vector<uint32_t>& indices, const std::vector<drape_vec3>& rest) {

@@ -59,14 +59,14 @@ bool writeRowsCsv(const std::string& path, const std::vector<Row>& rows, std::st
       "proxies_ms_median,proxies_ms_p90,cloth_ms_median,cloth_ms_p90,integrate_ms_median,integrate_ms_p90,"
       "collide_ms_median,collide_ms_p90,ms_per_sim_s,dev_rms_mm,dev_max_mm,stretch_p99_pct,stretch_max_pct,"
       "pen_p99_mm,pen_max_mm,deeper_2mm_pct,inside_mean,inside_max,energy_drift,energy_worst,"
-      "energy_exploded,nan_resets,openings_off_pct\n",
+      "energy_exploded,nan_resets,openings_off_pct,in_body_pct\n",
       f.get());
   for (const Row& r : rows) {
     const Setting& s = r.setting;
     std::fprintf(f.get(),
                  "%s,%s,%s,%s,%s,%s,%d,%.4g,%g,%u,%u,%u,%g,%u,%u,%d,%zu,%.4g,"
                  "%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,"
-                 "%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%u,%.5g,%.5g,%d,%u,%.4g\n",
+                 "%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%u,%.5g,%.5g,%d,%u,%.4g,%.5g\n",
                  csvText(s.sweep).c_str(), csvText(s.label).c_str(), csvText(r.take).c_str(), solverName(s.solver),
                  responseName(s.contact_response), csvText(s.backend).c_str(), s.is_default ? 1 : 0, r.rate_hz, s.substep_hz,
                  s.iterations, s.ring_points, s.continuous_collision, s.strain_limit, s.strain_limit_passes,
@@ -77,7 +77,7 @@ bool writeRowsCsv(const std::string& path, const std::vector<Row>& rows, std::st
                  r.integrate.p90, r.collide.median, r.collide.p90, r.ms_per_sim_s, r.dev_rms_mm, r.dev_max_mm,
                  100.0 * r.stretch_p99, 100.0 * r.stretch_max, r.pen_p99_mm, r.pen_max_mm, 100.0 * r.deeper_than_2mm,
                  r.inside_mean, r.inside_max, r.energy.drift, r.energy.worst, r.energy.exploded ? 1 : 0, r.nan_resets,
-                 100.0 * r.openings_off);
+                 100.0 * r.openings_off, 100.0 * r.in_body);
   }
   if (std::ferror(f.get())) {
     error = "error writing " + path;
@@ -107,7 +107,7 @@ bool writePeerCsv(const std::string& path, const std::vector<PeerResult>& peers,
       "engine,setting,take,rate_hz,particles,substeps_per_60hz,iterations,frames,cpu_ms_median,cpu_ms_p90,"
       "cpu_ms_per_60hz,cpu_ms_per_sim_s,bullet_over_drape_cpu,wall_ms_median,wall_ms_p90,"
       "bullet_over_drape_wall,stretch_p99_pct,stretch_max_pct,pen_p99_mm,pen_max_mm,deeper_2mm_pct,"
-      "inside_mean,sdf_voxel_m\n",
+      "inside_mean,sdf_voxel_m,in_body_pct\n",
       f.get());
   const std::string less_label = lessStretchLabel();
   for (const PeerResult& p : peers) {
@@ -117,14 +117,14 @@ bool writePeerCsv(const std::string& path, const std::vector<PeerResult>& peers,
       const PeerSide& over = side == 0 ? p.drape : s;
       const double cpu = median(s.cpu_ms);
       std::fprintf(
-          f.get(), "%s,%s,%s,%.4g,%u,%d,%d,%zu,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g\n",
+          f.get(), "%s,%s,%s,%.4g,%u,%d,%d,%zu,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g\n",
           side == 0 ? "bullet" : "drape",
           side == 0 ? csvText(p.label).c_str() : side == 1 ? "default" : less_label.c_str(), csvText(p.take).c_str(),
           p.rate_hz, p.particles, side == 0 ? p.substeps_per_60hz : 0, side == 0 ? p.iterations : 0, s.cpu_ms.size(),
           cpu, percentile(s.cpu_ms, 90.0), cpu * p.rate_hz / 60.0, cpu * p.rate_hz, bullet_cpu / median(over.cpu_ms),
           median(s.ms), percentile(s.ms, 90.0), bullet_wall / median(over.ms), 100.0 * s.stretch_p99,
           100.0 * s.stretch_max, s.penetration_p99_mm, s.penetration_max_mm, 100.0 * s.deeper_than_2mm, s.inside_mean,
-          side == 0 ? p.sdf_voxel_m : 0.0);
+          side == 0 ? p.sdf_voxel_m : 0.0, 100.0 * s.in_body);
     }
   }
   if (std::ferror(f.get())) {

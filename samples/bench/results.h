@@ -28,7 +28,7 @@ struct Row {
   double ms_per_sim_s = 0;  // frame median x replay rate: run time per simulated second
   double dev_rms_mm = 0, dev_max_mm = 0;
   double stretch_p99 = 0, stretch_max = 0;
-  double pen_p99_mm = 0, pen_max_mm = 0, deeper_than_2mm = 0;
+  double pen_p99_mm = 0, pen_max_mm = 0, deeper_than_2mm = 0, in_body = 0;
   double inside_mean = 0;
   uint32_t inside_max = 0;
   double openings_off = 0;  // fraction of measured frames with an opening off its body part

@@ -78,6 +78,7 @@ struct RunResult {
   // Error figures (measuring runs only).
   double stretch_p99 = 0, stretch_max = 0;
   double penetration_p99_mm = 0, penetration_max_mm = 0, deeper_than_2mm = 0;
+  double in_body = 0;      // vertex-frames inside the body mesh at any depth
   double inside_mean = 0;  // particles inside an ellipsoid, mean per frame
   uint32_t inside_max = 0;
   double openings_off = 0;  // fraction of measured frames with an opening off its body part
