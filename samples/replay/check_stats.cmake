@@ -82,7 +82,7 @@ foreach(path "drape_version" "recording" "format" "layout" "frames" "rejected_fr
              "garment|body_surface_stretch|max" "garment|body_surface_stretch|over_5pct"
              "garment|body_surface_stretch|tubes|edges" "garment|body_surface_stretch|tubes|p99"
              "garment|body_surface_stretch|tubes|over_5pct" "garment|proxy_inside" "garment|body_penetration_mm|p99"
-             "garment|body_penetration_mm|max" "garment|deeper_than_2mm" "garment|openings|tracked"
+             "garment|body_penetration_mm|max" "garment|deeper_than_2mm" "garment|inside_body" "garment|openings|tracked"
              "garment|openings|off_frames" "garment|openings|off_max" "garment|frames_measured"
              "garment|teleport_resets" "garment|nan_resets" "garment|contacts" "garment|substeps" "garment|under"
              "render|frames_rendered" "render|every" "render|camera" "render|width" "render|height"
@@ -200,7 +200,7 @@ set(_garment_numbers "stages_ms|cloth" "stages_ms|integrate" "stages_ms|collide"
     "garment|body_surface_stretch|over_5pct" "garment|body_surface_stretch|tubes|p99" "garment|contacts"
     "garment|substeps")
 set(_garment_measured "garment|body_penetration_mm|p99" "garment|body_penetration_mm|max"
-    "garment|deeper_than_2mm")
+    "garment|deeper_than_2mm" "garment|inside_body")
 expect_type(NUMBER stages_ms frame)
 if(EXPECT_GARMENT STREQUAL "none")
   expect_equal("particles" "${_particles}" 0)

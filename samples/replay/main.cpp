@@ -554,12 +554,13 @@ int run(int argc, char** argv) {
         return fail(kExitFailure, "drape_garment_measure failed on frame " + std::to_string(i) + ": " +
                                       libraryReason(r));
       const float measured[] = {acc.max_stretch, acc.p99_stretch, acc.mean_stretch, acc.body_penetration_p99_mm,
-                                acc.body_penetration_max_mm, acc.deeper_than_2mm};
+                                acc.body_penetration_max_mm, acc.deeper_than_2mm, acc.inside_body};
       for (float v : measured) st.nonfinite += static_cast<uint64_t>(!std::isfinite(v));
       st.proxy_inside += acc.proxy_inside;
       st.penetration_p99_mm.push_back(acc.body_penetration_p99_mm);
       st.penetration_max_mm.push_back(acc.body_penetration_max_mm);
       st.deeper_than_2mm.push_back(acc.deeper_than_2mm);
+      st.inside_body.push_back(acc.inside_body);
       st.openings = acc.openings;
       st.openings_off_frames += acc.openings_off > 0 ? 1u : 0u;
       st.openings_off_max = std::max(st.openings_off_max, acc.openings_off);

@@ -27,6 +27,7 @@ FIGURES = [
     ("P99 stretch %", lambda g: 100.0 * g["p99_stretch"], "{:7.2f}"),
     ("off frames", lambda g: float(g["openings"]["off_frames"]), "{:4.0f}"),
     ("> 2 mm %", lambda g: 100.0 * g["deeper_than_2mm"], "{:6.2f}"),
+    ("in body %", lambda g: 100.0 * g["inside_body"], "{:6.2f}"),  # stats files since 2026-12-01
     ("worst P99 mm", lambda g: g["body_penetration_mm"]["p99"], "{:6.1f}"),
     ("inside", lambda g: float(g["proxy_inside"]), "{:4.0f}"),
 ]

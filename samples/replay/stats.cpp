@@ -234,6 +234,7 @@ std::string statsJson(const ReplayStats& s) {
   w.key("max").value(maximum(s.penetration_max_mm));
   w.endObject();
   w.key("deeper_than_2mm").value(mean(s.deeper_than_2mm));
+  w.key("inside_body").value(mean(s.inside_body));
   w.key("openings").beginObject();
   w.key("tracked").value(s.openings);
   w.key("off_frames").value(s.openings_off_frames);
@@ -347,9 +348,11 @@ std::string summaryText(const ReplayStats& s, const std::string& obj_dir, const 
           100.0 * s.body_tube_stretch.fractionAbove(0.05));
     if (!s.penetration_p99_mm.empty())
       appendf(o, "inside      %llu particle-frames inside an ellipsoid; body penetration P99 %.2f mm (worst frame), "
-                 "max %.2f mm; %.3f %% deeper than 2 mm (mean of %zu measured frames)\n",
+                 "max %.2f mm; %.3f %% deeper than 2 mm, %.3f %% inside it at any depth (means of %zu measured "
+                 "frames)\n",
           static_cast<unsigned long long>(s.proxy_inside), maximum(s.penetration_p99_mm),
-          maximum(s.penetration_max_mm), 100.0 * mean(s.deeper_than_2mm), s.penetration_p99_mm.size());
+          maximum(s.penetration_max_mm), 100.0 * mean(s.deeper_than_2mm), 100.0 * mean(s.inside_body),
+          s.penetration_p99_mm.size());
     if (!s.penetration_p99_mm.empty())
       appendf(o, "openings    %u round a body part when dressed; one or more off it in %u of %zu measured frames "
                  "(at most %u at once)\n",

@@ -101,7 +101,7 @@ struct ReplayStats {
   uint32_t body_stretch_from_frame = 0;
   // Per measured frame (drape_garment_measure, --measure-every).
   uint64_t proxy_inside = 0;       // summed over measured frames
-  std::vector<double> penetration_p99_mm, penetration_max_mm, deeper_than_2mm;
+  std::vector<double> penetration_p99_mm, penetration_max_mm, deeper_than_2mm, inside_body;
   // Openings (drape_garment_accuracy.openings): those round a body part when dressed, measured
   // frames with one or more off it, and the most off in one frame.
   uint32_t openings = 0, openings_off_frames = 0, openings_off_max = 0;

@@ -524,7 +524,10 @@ struct Machine {
                            std::isfinite(a.body_penetration_p99_mm) && std::isfinite(a.body_penetration_max_mm) &&
                            std::isfinite(a.deeper_than_2mm),
                        "garment accuracy finite");
-      if (a.struct_size == sizeof a) DRAPE_FUZZ_CHECK(a.openings_off <= a.openings, "openings off <= openings");
+      if (a.struct_size == sizeof a) {
+        DRAPE_FUZZ_CHECK(a.openings_off <= a.openings, "openings off <= openings");
+        DRAPE_FUZZ_CHECK(a.inside_body >= a.deeper_than_2mm && a.inside_body <= 1.0f, "inside the body: a fraction, at least those deeper than 2 mm");
+      }
     }
     if (live) checkGarment(g);
   }

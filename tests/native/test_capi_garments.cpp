@@ -145,9 +145,11 @@ TEST(CApiGarments, TemplateGarmentFollowsTheBody) {
 // A struct that grew (drape_garment_stats, drape_garment_accuracy): a caller built against its first
 // version (`v1` bytes) still gets those fields, as the full struct has them, and nothing written past
 // them; a struct_size below that is an error that writes nothing. `read` fills the struct at its
-// argument; `full` is the whole struct read the same way.
+// argument; `full` is the whole struct read the same way. For a later version (`first` false) only
+// the first part: 4 bytes less than it is an earlier version, not an error.
 template <class Struct, class Read>
-void expectFirstStructVersionFilled(const Struct& full, uint32_t v1, const char* size_field, Read read) {
+void expectFirstStructVersionFilled(const Struct& full, uint32_t v1, const char* size_field, Read read,
+                                    bool first = true) {
   alignas(Struct) unsigned char buf[sizeof(Struct)];
   std::memset(buf, 0xAB, sizeof(buf));
   std::memcpy(buf, &v1, sizeof(v1));
@@ -157,6 +159,7 @@ void expectFirstStructVersionFilled(const Struct& full, uint32_t v1, const char*
   std::memcpy(&written, buf, sizeof(written));
   EXPECT_EQ(written, v1);
   for (size_t k = v1; k < sizeof(buf); ++k) ASSERT_EQ(buf[k], 0xAB) << "byte " << k << " written past struct_size";
+  if (!first) return;
   std::memset(buf, 0xAB, sizeof(buf));
   const uint32_t too_small = v1 - 4;
   std::memcpy(buf, &too_small, sizeof(too_small));
@@ -177,8 +180,8 @@ TEST(CApiGarments, StatsOfTheFirstStructVersionAreStillFilled) {
                                  [&](drape_garment_stats* out) { return drape_garment_get_stats(g, out); });
 }
 
-// drape_garment_accuracy grew the openings (32 -> 40 bytes).
-TEST(CApiGarments, AccuracyCountsOpeningsAndTheFirstStructVersionIsStillFilled) {
+// drape_garment_accuracy grew the openings (32 -> 40 bytes) and inside_body (-> 44).
+TEST(CApiGarments, AccuracyCountsOpeningsAndTheEarlierStructVersionsAreStillFilled) {
   ContextPtr ctx = makeContext();
   drape_garment* g = addTShirt(ctx.get());
   ASSERT_NE(g, nullptr);
@@ -186,11 +189,19 @@ TEST(CApiGarments, AccuracyCountsOpeningsAndTheFirstStructVersionIsStillFilled) 
   drape_garment_accuracy full;
   full.struct_size = sizeof(full);
   ASSERT_OK(drape_garment_measure(g, &full));
-  EXPECT_EQ(full.struct_size, 40u);
+  EXPECT_EQ(full.struct_size, 44u);
   EXPECT_EQ(full.openings, 4u);  // hem, collar, two sleeves
   EXPECT_EQ(full.openings_off, 0u);
-  expectFirstStructVersionFilled(full, 32, "drape_garment_accuracy.struct_size",
-                                 [&](drape_garment_accuracy* out) { return drape_garment_measure(g, out); });
+  // Inside the body at any depth: a fraction, at least the vertices deeper than 2 mm, and not 0
+  // exactly when some vertex is inside (the deepest's depth above 0).
+  EXPECT_GE(full.inside_body, full.deeper_than_2mm);
+  EXPECT_LE(full.inside_body, 1.0f);
+  EXPECT_EQ(full.inside_body > 0.0f, full.body_penetration_max_mm > 0.0f)
+      << full.inside_body << " inside, deepest " << full.body_penetration_max_mm << " mm";
+  for (uint32_t version : {32u, 40u})
+    expectFirstStructVersionFilled(full, version, "drape_garment_accuracy.struct_size",
+                                   [&](drape_garment_accuracy* out) { return drape_garment_measure(g, out); },
+                                   version == 32u);
 }
 
 // drape_cloth_params grew collision_stride (128 -> 132 bytes): a caller of the first layout reads

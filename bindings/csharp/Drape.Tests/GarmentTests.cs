@@ -182,7 +182,7 @@ namespace Drape.Tests
             Assert.Equal(0.0, s.DeviceKernelMs + s.DeviceUploadMs + s.DeviceReadbackMs + s.DeviceHostMs);
 
             GarmentAccuracy a = g.Measure();
-            Assert.Equal(40u, a.StructSize);
+            Assert.Equal(44u, a.StructSize);
             // A T-shirt's collar, hem and two sleeves each go round their body part; after 30 frames
             // of the synthetic take (arms at the sides) none has come off.
             Assert.True(a.Openings >= 4, $"openings {a.Openings}");
@@ -191,6 +191,8 @@ namespace Drape.Tests
             Assert.True(float.IsFinite(a.MaxStretch) && float.IsFinite(a.MeanStretch));
             Assert.True(a.P99Stretch <= a.MaxStretch);
             Assert.InRange(a.DeeperThan2mm, 0f, 1f);
+            // Inside the body at any depth: a fraction, at least those deeper than 2 mm.
+            Assert.InRange(a.InsideBody, a.DeeperThan2mm, 1f);
             _output.WriteLine($"T-shirt: {s.Particles} particles, {s.Attached} attached, {s.Substeps} substeps, " +
                               $"{s.StepMs:F2} ms/step; stretch p99 {a.P99Stretch:F4} max {a.MaxStretch:F4}; " +
                               $"penetration p99 {a.BodyPenetrationP99Mm:F1} mm");

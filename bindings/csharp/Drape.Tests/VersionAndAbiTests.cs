@@ -211,10 +211,10 @@ namespace Drape.Tests
             ("DeviceHostMs", 96));
 
         [Fact]
-        public void GarmentAccuracy_Is40() => AssertLayout<GarmentAccuracy>(40,
+        public void GarmentAccuracy_Is44() => AssertLayout<GarmentAccuracy>(44,
             ("StructSize", 0), ("ProxyInside", 4), ("MaxStretch", 8), ("P99Stretch", 12), ("MeanStretch", 16),
             ("BodyPenetrationP99Mm", 20), ("BodyPenetrationMaxMm", 24), ("DeeperThan2mm", 28), ("Openings", 32),
-            ("OpeningsOff", 36));
+            ("OpeningsOff", 36), ("InsideBody", 40));
 
         [Fact]
         public void RecordingInfo_Is32() => AssertLayout<RecordingInfo>(32,

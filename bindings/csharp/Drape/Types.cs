@@ -814,5 +814,8 @@ namespace Drape
         /// <summary>openings_off: of those, the ones off their body part now (a sleeve the arm has
         /// left).</summary>
         public uint OpeningsOff;
+        /// <summary>inside_body: fraction of vertices inside the body mesh at any depth (winding number
+        /// &gt;= 1), how ANCHORS.md counts "cloth inside the body" (NvCloth 0.40 %); 0 before an update.</summary>
+        public float InsideBody;
     }
 }

@@ -761,8 +761,8 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_get_stats(drape_garment* garment
                                                           drape_garment_stats* out_stats);
 
 /* Accuracy of the garment now (a diagnostic, ~0.6 ms per 1 000 particles). The struct grew from
- * 32 to 40 bytes (openings); a caller passing the first version's struct_size (32) gets those
- * fields as before and nothing written past them. */
+ * 32 to 40 bytes (openings) and to 44 (inside_body); a caller passing an earlier version's
+ * struct_size (32 or 40) gets those fields as before and nothing written past them. */
 typedef struct drape_garment_accuracy {
   uint32_t struct_size;            /* caller sets sizeof(drape_garment_accuracy) */
   uint32_t proxy_inside;           /* particles inside an ellipsoid they collide with, > 0.1 mm */
@@ -779,6 +779,9 @@ typedef struct drape_garment_accuracy {
    * leg the foot came out of through the cloth). docs/garments.md, "Openings". */
   uint32_t openings;
   uint32_t openings_off;
+  float inside_body;               /* fraction of vertices inside the body mesh at any depth (winding
+                                      number >= 1): how ../shared/ANCHORS.md counts "cloth inside the
+                                      body" (NvCloth 0.40 %). 0 before an update */
 } drape_garment_accuracy;
 
 DRAPE_API drape_result DRAPE_CALL drape_garment_measure(drape_garment* garment,

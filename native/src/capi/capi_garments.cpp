@@ -646,8 +646,8 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_measure(drape_garment* handle, d
   return guarded("drape_garment_measure", [&]() -> drape_result {
     DRAPE_CHECK_GARMENT("drape_garment_measure", handle);
     if (!out) return fail(DRAPE_ERROR_NULL_ARGUMENT, "drape_garment_measure: out_accuracy is NULL");
-    // The first version of the struct (up to openings: 32 bytes) is still accepted: the caller's
-    // struct_size says how many bytes are its own.
+    // The earlier versions of the struct (up to openings: 32 bytes; up to inside_body: 40) are still
+    // accepted: the caller's struct_size says how many bytes are its own.
     constexpr uint32_t kFirstVersionSize = offsetof(drape_garment_accuracy, openings);
     if (drape_result r = checkStructSize(out->struct_size, kFirstVersionSize, "drape_garment_accuracy")) return r;
     const drape::GarmentAccuracy a = static_cast<Context*>(garment->api_owner)->measureGarment(*garment);
@@ -663,6 +663,7 @@ DRAPE_API drape_result DRAPE_CALL drape_garment_measure(drape_garment* handle, d
     o.deeper_than_2mm = a.deeper_than_2mm;
     o.openings = a.openings.tracked;
     o.openings_off = a.openings.off;
+    o.inside_body = a.inside_body;
     o.struct_size = std::min<uint32_t>(out->struct_size, sizeof(o));
     std::memcpy(out, &o, o.struct_size);
     return DRAPE_OK;
@@ -676,8 +677,9 @@ static_assert(sizeof(drape_garment_template) == 24, "drape_garment_template layo
 static_assert(sizeof(drape_mesh_fit) == 48, "drape_mesh_fit layout");
 static_assert(sizeof(drape_garment_stats) == 104, "drape_garment_stats layout");
 static_assert(offsetof(drape_garment_stats, device_upload_ms) == 72, "drape_garment_stats: the first version's 72 bytes moved");
-static_assert(sizeof(drape_garment_accuracy) == 40, "drape_garment_accuracy layout");
+static_assert(sizeof(drape_garment_accuracy) == 44, "drape_garment_accuracy layout");
 static_assert(offsetof(drape_garment_accuracy, openings) == 32, "drape_garment_accuracy: the first version's 32 bytes moved");
+static_assert(offsetof(drape_garment_accuracy, inside_body) == 40, "drape_garment_accuracy: the second version's 40 bytes moved");
 static_assert(sizeof(drape_cloth_params) == 136, "drape_cloth_params layout");
 static_assert(offsetof(drape_cloth_params, strain_limit_passes) == DRAPE_CLOTH_PARAMS_SIZE_V2,
               "drape_cloth_params: the second version's 132 bytes moved");

@@ -836,10 +836,11 @@ GarmentAccuracy GarmentSim::measure(const std::vector<Ellipsoid>& ellipsoids, co
     for (size_t i = 0; i < points.size(); ++i) points[i] = x[i].head<3>();
     scratch.assign(points.size(), 0.0f);
     bvh->depthsInside(points.data(), points.size(), scratch.data());
-    size_t deep = 0;
+    size_t deep = 0, inside = 0;
     for (float& depth : scratch) {
       depth *= 1000.0f;
       if (depth > 2.0f) ++deep;
+      if (depth > 0.0f) ++inside;
     }
     if (!scratch.empty()) {
       const size_t k = std::min(scratch.size() - 1, static_cast<size_t>(std::ceil(0.99 * static_cast<double>(scratch.size()))) - 1);
@@ -847,6 +848,7 @@ GarmentAccuracy GarmentSim::measure(const std::vector<Ellipsoid>& ellipsoids, co
       a.body_penetration_p99_mm = scratch[k];
       a.body_penetration_max_mm = *std::max_element(scratch.begin(), scratch.end());
       a.deeper_than_2mm = static_cast<float>(deep) / static_cast<float>(scratch.size());
+      a.inside_body = static_cast<float>(inside) / static_cast<float>(scratch.size());
     }
   }
   if (body != nullptr) a.openings = openings_.count(x, particleCount(), *body);

@@ -110,6 +110,7 @@ struct GarmentAccuracy {
   float body_penetration_p99_mm = 0;   // depth of garment vertices inside the body mesh
   float body_penetration_max_mm = 0;
   float deeper_than_2mm = 0;           // fraction of vertices more than 2 mm inside the body
+  float inside_body = 0;               // fraction of vertices inside the body at any depth
   OpeningCount openings;               // openings round a body part at rest, and those off it now
                                        // (cloth/garment_openings.h); 0 / 0 without a body
 };
