@@ -38,6 +38,8 @@ struct PeerSide {
   double stretch_p99 = 0, stretch_max = 0;
   double penetration_p99_mm = 0, penetration_max_mm = 0, deeper_than_2mm = 0;
   double in_body = 0;      // vertex-frames inside the body mesh at any depth
+  size_t openings_tracked = 0;  // openings round a body part on the first frame (OpeningsMeter)
+  double openings_off = 0;      // frames with one or more of them off it
   double inside_mean = 0;  // free vertices inside any tracking ellipsoid, per frame
   bool finite = true;
 };

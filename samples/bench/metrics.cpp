@@ -1,5 +1,8 @@
 #include "metrics.h"
 
+#include "cloth/garment_openings.h"
+#include "cloth/garment_topology.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -59,6 +62,93 @@ double PenetrationMeter::deeperThan2mmFraction() const {
 }
 double PenetrationMeter::insideFraction() const {
   return depth_mm_.empty() ? kNaN : static_cast<double>(inside_) / static_cast<double>(depth_mm_.size());
+}
+
+namespace {
+
+drape::Vec3 v3(const drape_vec3& v) { return drape::Vec3(v.x, v.y, v.z); }
+
+// The body parts of OpeningsMeter (metrics.h) from this frame's ellipsoids: spine, left arm, right
+// arm, left leg, right leg.
+void bodyParts(const std::vector<drape_ellipsoid>& ellipsoids, std::vector<std::vector<drape::Vec3>>& parts) {
+  using drape::Vec3;
+  constexpr float kSpineExtensionM = drape::GarmentOpenings::kSpineExtensionM;
+  constexpr float kLegExtensionM = drape::GarmentOpenings::kLegExtensionM;
+  // Per chain: ring -> (sum of centres, count), and the ellipsoid of the highest ring (its end).
+  std::map<int, std::pair<Vec3, int>> rings[6];
+  const drape_ellipsoid* last[6] = {};
+  for (const drape_ellipsoid& e : ellipsoids) {
+    if (e.chain < 0 || e.chain > 5) continue;
+    auto& r = rings[e.chain][e.ring];
+    if (r.second == 0) r.first = Vec3::Zero();
+    r.first += v3(e.centre);
+    ++r.second;
+    if (!last[e.chain] || e.ring >= last[e.chain]->ring) last[e.chain] = &e;
+  }
+  auto centres = [&](int chain) {
+    std::vector<Vec3> c;
+    for (const auto& [ring, sum] : rings[chain]) c.push_back(sum.first / static_cast<float>(sum.second));
+    return c;
+  };
+  // On past the last centre by the last ellipsoid's half-length along its bone, away from the part.
+  auto toTip = [&](int chain, std::vector<Vec3>& line) {
+    if (line.size() < 2 || !last[chain]) return;
+    Vec3 dir = v3(last[chain]->axis_y);
+    if (dir.dot(line.back() - line[line.size() - 2]) < 0.0f) dir = -dir;
+    line.push_back(v3(last[chain]->centre) + last[chain]->radii.y * dir);
+  };
+  parts.assign(5, {});
+  std::vector<Vec3>& spine = parts[0];
+  spine = centres(0);
+  const std::vector<Vec3> head = centres(1);
+  spine.insert(spine.end(), head.begin(), head.end());
+  if (spine.size() >= 2) {
+    const Vec3 down = (spine[0] - spine[1]).normalized();
+    spine.insert(spine.begin(), spine[0] + kSpineExtensionM * down);
+  }
+  toTip(1, spine);
+  for (int chain = 2; chain <= 5; ++chain) {
+    std::vector<Vec3>& line = parts[static_cast<size_t>(chain - 1)];
+    line = centres(chain);
+    if (chain >= 4 && line.size() >= 2) line.insert(line.begin(), line[0] + kLegExtensionM * (line[0] - line[1]).normalized());
+    toTip(chain, line);
+  }
+}
+
+}  // namespace
+
+void OpeningsMeter::bind(const std::vector<uint32_t>& indices, const drape_vec3* x, size_t n,
+                         const std::vector<drape_ellipsoid>& ellipsoids) {
+  openings_.clear();
+  bodyParts(ellipsoids, parts_);
+  for (std::vector<uint32_t>& loop : drape::boundaryLoops(indices, n)) {
+    loop_.clear();
+    for (uint32_t v : loop) loop_.push_back(v3(x[v]));
+    float best = 0.0f;
+    size_t best_part = 0;
+    for (size_t p = 0; p < parts_.size(); ++p) {
+      const float linking = drape::loopLinking(loop_, parts_[p]);
+      if (std::fabs(linking) > std::fabs(best)) best = linking, best_part = p;
+    }
+    if (std::fabs(best) < drape::GarmentOpenings::kBindLinking) continue;
+    openings_.push_back({std::move(loop), best_part, best > 0.0f ? 1 : -1});
+  }
+}
+
+void OpeningsMeter::addFrame(const drape_vec3* x, const std::vector<drape_ellipsoid>& ellipsoids) {
+  bodyParts(ellipsoids, parts_);
+  bool off = false;
+  for (const Opening& o : openings_) {
+    loop_.clear();
+    for (uint32_t v : o.loop) loop_.push_back(v3(x[v]));
+    off = off || static_cast<float>(o.sign) * drape::loopLinking(loop_, parts_[o.part]) < drape::GarmentOpenings::kOffLinking;
+  }
+  ++frames_;
+  off_frames_ += off ? 1 : 0;
+}
+
+double OpeningsMeter::offFraction() const {
+  return frames_ == 0 ? kNaN : static_cast<double>(off_frames_) / static_cast<double>(frames_);
 }
 
 void StretchMeter::setMesh(const std::vector<uint32_t>& indices, const std::vector<drape_vec3>& rest) {

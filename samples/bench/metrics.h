@@ -51,6 +51,36 @@ class PenetrationMeter {
   size_t deep_ = 0, inside_ = 0;
 };
 
+// Openings (the mesh's boundary loops: hem, collar, cuffs) off the body part they went round, counted
+// the same way for every engine's vertices: the library's measure (drape_garment_accuracy.openings,
+// cloth/garment_openings.h: Gauss linking of loop and body-part polyline, bound at >= 0.75, off
+// below 0.5 of the same sign) on body parts built from the tracking ellipsoids, which every engine
+// here meets, instead of the library's rings: per chain the mean centre of each ring's ellipsoids, in
+// ring order (the spine: torso, then head; 0.5 m on below the pelvis, legs from 0.15 m above their
+// first ring, as the library's), each limb and the head on to its last ellipsoid's end.
+class OpeningsMeter {
+ public:
+  // The openings of `indices` at `x` (the dressed garment of the first frame) and the body part
+  // each goes round there; openings round none are not tracked.
+  void bind(const std::vector<uint32_t>& indices, const drape_vec3* x, size_t n,
+            const std::vector<drape_ellipsoid>& ellipsoids);
+  void addFrame(const drape_vec3* x, const std::vector<drape_ellipsoid>& ellipsoids);
+  size_t tracked() const { return openings_.size(); }
+  // Frames with one or more tracked openings off their body part, over the frames added.
+  double offFraction() const;
+
+ private:
+  struct Opening {
+    std::vector<uint32_t> loop;
+    size_t part = 0;
+    int sign = 1;
+  };
+  std::vector<Opening> openings_;
+  std::vector<std::vector<drape::Vec3>> parts_;
+  std::vector<drape::Vec3> loop_;
+  size_t frames_ = 0, off_frames_ = 0;
+};
+
 // Stretch |len| / rest - 1 of each structural edge (each undirected triangle edge once).
 class StretchMeter {
  public:

@@ -177,38 +177,40 @@ std::string renderReport(const ReportInput& in) {
          "(Bullet: its stepSimulation calls; Drape: push + its whole step, skeleton to cloth, measured beside it in "
          "the same frame); wall time of the cloth step alone in brackets. Penetration and stretch by the same meters "
          "for both; in body = vertex-frames inside the body mesh at any depth (ANCHORS.md's \"cloth inside the "
-         "body\": NvCloth 0.40 %, Bullet 4 x 10 2.2 %); inside = free vertices inside any tracking ellipsoid (Drape's garments collide only with their "
+         "body\": NvCloth 0.40 %, Bullet 4 x 10 2.2 %); off = frames with an opening (hem, collar, a sleeve's "
+         "cuff) off the body part it went round at the start, by one meter for all three (OpeningsMeter: the "
+         "library's linking test on body parts through the ellipsoids' centres); inside = free vertices inside any tracking ellipsoid (Drape's garments collide only with their "
          "own body parts' ellipsoids, so sleeve cloth resting on the torso counts here). Bullet meets the "
          "ellipsoids through a distance field sampled on a voxel grid (the setting's field); Bullet's own 0.25 m "
          "voxel is coarser than a forearm and lets the cloth sink into the body, so the peer's is finer and the "
          "target below is judged on it.\n\n";
     o +=
         "| take | engine | setting | CPU ms per frame (wall, cloth) | CPU ms per 1/60 s | Bullet / Drape (CPU; wall) | "
-        "stretch % P99 / max | penetration mm P99 / max | > 2 mm % | in body % | inside "
-        "|\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "stretch % P99 / max | penetration mm P99 / max | > 2 mm % | in body % | off % | inside "
+        "|\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const PeerResult& p : in.peers) {
       const double b = median(p.bullet.cpu_ms), d = median(p.drape.cpu_ms);
       const double bw = median(p.bullet.ms), dw = median(p.drape.ms);
       appendf(o,
               "| %s (%.0f Hz, %u particles) | Bullet 3.24 | %s (substeps per 1/60 s x iterations) | %.2f (%.2f) | "
-              "%.2f | **%.0fx**; %.0fx | %.1f / %.1f | %.1f / %.1f | %.2f | %.2f | %.1f |\n",
+              "%.2f | **%.0fx**; %.0fx | %.1f / %.1f | %.1f / %.1f | %.2f | %.2f | %.0f | %.1f |\n",
               p.take.c_str(), p.rate_hz, p.particles, p.label.c_str(), b, bw, b * p.rate_hz / 60.0, b / d, bw / dw,
               100.0 * p.bullet.stretch_p99, 100.0 * p.bullet.stretch_max, p.bullet.penetration_p99_mm,
               p.bullet.penetration_max_mm, 100.0 * p.bullet.deeper_than_2mm, 100.0 * p.bullet.in_body,
-              p.bullet.inside_mean);
+              100.0 * p.bullet.openings_off, p.bullet.inside_mean);
       appendf(
-          o, "| | Drape | default, beside it | %.3f (%.3f) | %.3f | 1 | %.2f / %.1f | %.2f / %.1f | %.2f | %.2f | %.2f |\n",
+          o, "| | Drape | default, beside it | %.3f (%.3f) | %.3f | 1 | %.2f / %.1f | %.2f / %.1f | %.2f | %.2f | %.0f | %.2f |\n",
           d, dw, d * p.rate_hz / 60.0, 100.0 * p.drape.stretch_p99, 100.0 * p.drape.stretch_max,
           p.drape.penetration_p99_mm, p.drape.penetration_max_mm, 100.0 * p.drape.deeper_than_2mm,
-          100.0 * p.drape.in_body, p.drape.inside_mean);
+          100.0 * p.drape.in_body, 100.0 * p.drape.openings_off, p.drape.inside_mean);
       const PeerSide& l = p.drape_less;
       const double lc = median(l.cpu_ms), lw = median(l.ms);
       appendf(o,
               "| | Drape | %s, beside it | %.3f (%.3f) | %.3f | **%.0fx**; %.0fx | "
-              "%.2f / %.1f | %.2f / %.1f | %.2f | %.2f | %.2f |\n",
+              "%.2f / %.1f | %.2f / %.1f | %.2f | %.2f | %.0f | %.2f |\n",
               lessStretchLabel().c_str(), lc, lw, lc * p.rate_hz / 60.0, b / lc, bw / lw,
               100.0 * l.stretch_p99, 100.0 * l.stretch_max, l.penetration_p99_mm, l.penetration_max_mm,
-              100.0 * l.deeper_than_2mm, 100.0 * l.in_body, l.inside_mean);
+              100.0 * l.deeper_than_2mm, 100.0 * l.in_body, 100.0 * l.openings_off, l.inside_mean);
     }
     for (const PeerResult& p : in.peers) {
       if (p.substeps_per_60hz != 4 || p.iterations != 10 || p.sdf_voxel_m != in.peer_field_m) continue;
@@ -222,10 +224,11 @@ std::string renderReport(const ReportInput& in) {
         const std::string setting = side == 0 ? "Drape's default" : "Drape at " + lessStretchLabel();
         appendf(o,
                 "\nTarget on `%s` (Drape >= 50x faster than Bullet 4 x 10, with less penetration and stretch; "
-                "Bullet on its %g cm field), %s: %.0fx faster in CPU time (%s), penetration %s, stretch %s.%s",
+                "Bullet on its %g cm field), %s: %.0fx faster in CPU time (%s), penetration %s, stretch %s "
+                "(an opening off its body part in %.0f %% of the frames, Bullet's in %.0f %%).%s",
                 p.take.c_str(), 100.0 * p.sdf_voxel_m, setting.c_str(), ratio, ratio >= 50.0 ? "met" : "NOT met",
                 less_pen ? "less (met)" : "NOT less", less_stretch ? "less (met)" : "NOT less",
-                side == 0 ? "" : "\n");
+                100.0 * d.openings_off, 100.0 * p.bullet.openings_off, side == 0 ? "" : "\n");
         if (side == 0)
           appendf(o, " Bullet 4 x 10 here: %.1f ms per 1/60 s (ANCHORS.md: %.0f ms).\n",
                   median(p.bullet.cpu_ms) * p.rate_hz / 60.0, kBulletAnchorMsPer60Hz);

@@ -107,7 +107,7 @@ bool writePeerCsv(const std::string& path, const std::vector<PeerResult>& peers,
       "engine,setting,take,rate_hz,particles,substeps_per_60hz,iterations,frames,cpu_ms_median,cpu_ms_p90,"
       "cpu_ms_per_60hz,cpu_ms_per_sim_s,bullet_over_drape_cpu,wall_ms_median,wall_ms_p90,"
       "bullet_over_drape_wall,stretch_p99_pct,stretch_max_pct,pen_p99_mm,pen_max_mm,deeper_2mm_pct,"
-      "inside_mean,sdf_voxel_m,in_body_pct\n",
+      "inside_mean,sdf_voxel_m,in_body_pct,openings_off_pct\n",
       f.get());
   const std::string less_label = lessStretchLabel();
   for (const PeerResult& p : peers) {
@@ -117,14 +117,14 @@ bool writePeerCsv(const std::string& path, const std::vector<PeerResult>& peers,
       const PeerSide& over = side == 0 ? p.drape : s;
       const double cpu = median(s.cpu_ms);
       std::fprintf(
-          f.get(), "%s,%s,%s,%.4g,%u,%d,%d,%zu,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g\n",
+          f.get(), "%s,%s,%s,%.4g,%u,%d,%d,%zu,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.4g\n",
           side == 0 ? "bullet" : "drape",
           side == 0 ? csvText(p.label).c_str() : side == 1 ? "default" : less_label.c_str(), csvText(p.take).c_str(),
           p.rate_hz, p.particles, side == 0 ? p.substeps_per_60hz : 0, side == 0 ? p.iterations : 0, s.cpu_ms.size(),
           cpu, percentile(s.cpu_ms, 90.0), cpu * p.rate_hz / 60.0, cpu * p.rate_hz, bullet_cpu / median(over.cpu_ms),
           median(s.ms), percentile(s.ms, 90.0), bullet_wall / median(over.ms), 100.0 * s.stretch_p99,
           100.0 * s.stretch_max, s.penetration_p99_mm, s.penetration_max_mm, 100.0 * s.deeper_than_2mm, s.inside_mean,
-          side == 0 ? p.sdf_voxel_m : 0.0, 100.0 * s.in_body);
+          side == 0 ? p.sdf_voxel_m : 0.0, 100.0 * s.in_body, 100.0 * s.openings_off);
     }
   }
   if (std::ferror(f.get())) {
