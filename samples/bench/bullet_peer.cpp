@@ -65,14 +65,20 @@ struct World {
 struct GarmentMeters {
   StretchMeter stretch;
   PenetrationMeter pen;
+  OpeningsMeter openings;
   std::vector<double> inside;
   void addFrame(const BodySurface& body, const drape_vec3* x, size_t n, const std::vector<uint8_t>& pinned,
                 const std::vector<drape_ellipsoid>& ellipsoids) {
     pen.addFrame(body, x, n);
     stretch.addFrame(x);
+    openings.addFrame(x, ellipsoids);
     inside.push_back(countInsideEllipsoids(x, n, pinned, ellipsoids));
   }
-  void finish(PeerSide& side) const { readErrors(stretch, pen, inside, side); }
+  void finish(PeerSide& side) const {
+    readErrors(stretch, pen, inside, side);
+    side.openings_tracked = openings.tracked();
+    side.openings_off = openings.offFraction();
+  }
 };
 
 // Frame i of the take into one Drape context: push, step, then its garment's vertices into x.
@@ -267,7 +273,10 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
 
   // Bullet's garment, Drape's default and Drape's setting with less stretch.
   GarmentMeters m_bullet, m_drape, m_less;
-  for (GarmentMeters* m : {&m_bullet, &m_drape, &m_less}) m->stretch.setMesh(indices, rest);
+  for (GarmentMeters* m : {&m_bullet, &m_drape, &m_less}) {
+    m->stretch.setMesh(indices, rest);
+    m->openings.bind(indices, x.data(), nv, e_end);  // the driver's dressed garment, which all three start from
+  }
   BodySurface surface;
   std::vector<drape_vec3> pin_start(nv);
   for (size_t i = 1; i < take.frames.size(); ++i) {
