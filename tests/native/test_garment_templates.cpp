@@ -213,7 +213,7 @@ INSTANTIATE_TEST_SUITE_P(Kinds, GarmentTemplate, testing::ValuesIn(allCases()), 
 // into one triangle wound both ways: an edge of four triangles (weldShortEdges). The count is
 // also checked here, over the range where the resolution can reach it.
 TEST(GarmentTemplateResolution, EveryCountIsAConsistentManifoldNearTheTarget) {
-  const int step = drape::test::kSanitizedBuild ? 211 : 37;
+  const int step = drape::test::kSanitizedBuild ? 421 : 37;  // 8 counts a kind and body there (7 s -> 4 s)
   int cases = 0;
   for (GarmentKind kind : {GarmentKind::TShirt, GarmentKind::Skirt, GarmentKind::Trousers, GarmentKind::LongSleeve,
                            GarmentKind::Dress}) {
@@ -261,7 +261,8 @@ TEST(GarmentTemplateResolution, ExtremeBodiesAndParametersGiveConsistentManifold
   int cases = 0;
   for (float height : {1.45f, 1.75f, 2.05f}) {
     for (float bmi : {16.0f, 30.0f, 40.0f}) {
-      if (drape::test::kSanitizedBuild && bmi != 30.0f) continue;
+      // Under the sanitizers the two bodies of the four that failed before (7.8 s -> 5 s there).
+      if (drape::test::kSanitizedBuild && (bmi != 30.0f || height < 1.7f)) continue;
       const Body body(height, bmi * height * height);
       for (GarmentKind kind : {GarmentKind::TShirt, GarmentKind::Skirt, GarmentKind::Trousers,
                                GarmentKind::LongSleeve, GarmentKind::Dress}) {
@@ -310,7 +311,7 @@ TEST(GarmentTemplateResolution, ExtremeBodiesAndParametersGiveConsistentManifold
       }
     }
   }
-  EXPECT_GT(cases, 100);
+  EXPECT_EQ(cases, drape::test::kSanitizedBuild ? 80 : 360);
 }
 
 TEST(GarmentTemplateInput, BadParamsRejectedAndOutputUntouched) {
