@@ -207,6 +207,32 @@ std::vector<Case> allCases() {
 
 INSTANTIATE_TEST_SUITE_P(Kinds, GarmentTemplate, testing::ValuesIn(allCases()), caseName);
 
+// How a mesh uses its edges: undirected edges in more than two triangles, directed edges used other
+// than once (inconsistent winding), vertices in no triangle, and triangles of an area the topology
+// refuses (below 1e-12 m^2).
+struct MeshEdgeUse {
+  int shared = 0, twice = 0, unused = 0, slivers = 0;
+};
+MeshEdgeUse meshEdgeUse(const GarmentMesh& m) {
+  MeshEdgeUse u;
+  std::map<std::pair<uint32_t, uint32_t>, int> directed, undirected;
+  std::vector<char> used(m.positions.size(), 0);
+  for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
+    const Vec3 &a = m.positions[m.indices[t]], &b = m.positions[m.indices[t + 1]], &c = m.positions[m.indices[t + 2]];
+    u.slivers += !(0.5f * (b - a).cross(c - a).norm() >= 1e-12f);
+    for (size_t k = 0; k < 3; ++k) {
+      const uint32_t p = m.indices[t + k], q = m.indices[t + (k + 1) % 3];
+      used[p] = 1;
+      ++directed[{p, q}];
+      ++undirected[{std::min(p, q), std::max(p, q)}];
+    }
+  }
+  for (const auto& [e, n] : undirected) u.shared += n > 2;
+  for (const auto& [e, n] : directed) u.twice += n != 1;
+  u.unused = static_cast<int>(std::count(used.begin(), used.end(), 0));
+  return u;
+}
+
 // Every resolution, not only the two above: on the heavy body the trousers' leg tubes pass within
 // the weld's tolerance of the crotch bridge at some counts (1 244-1 540, 2 021-2 058, 3 094-3 168
 // of a sweep in steps of 37), and the weld folded the two legs' triangles over a bridge segment
@@ -226,19 +252,9 @@ TEST(GarmentTemplateResolution, EveryCountIsAConsistentManifoldNearTheTarget) {
         std::string err;
         const std::string name = std::string(garmentKindName(kind)) + (heavy ? " heavy " : " thin ") + std::to_string(target);
         ASSERT_TRUE(makeGarmentTemplate((heavy ? heavyBody() : thinBody()).model, p, m, err)) << name << ": " << err;
-        std::map<std::pair<uint32_t, uint32_t>, int> directed, undirected;
-        for (size_t t = 0; t < m.indices.size(); t += 3) {
-          for (size_t k = 0; k < 3; ++k) {
-            const uint32_t u = m.indices[t + k], v = m.indices[t + (k + 1) % 3];
-            ++directed[{u, v}];
-            ++undirected[{std::min(u, v), std::max(u, v)}];
-          }
-        }
-        int shared = 0, twice = 0;
-        for (const auto& [e, n] : undirected) shared += n > 2;
-        for (const auto& [e, n] : directed) twice += n != 1;
-        EXPECT_EQ(shared, 0) << name << ": edges in more than two triangles";
-        EXPECT_EQ(twice, 0) << name << ": a directed edge used twice";
+        const MeshEdgeUse use = meshEdgeUse(m);
+        EXPECT_EQ(use.shared, 0) << name << ": edges in more than two triangles";
+        EXPECT_EQ(use.twice, 0) << name << ": a directed edge used twice";
         // Within 1 % before the weld where a ring's worth of points allows it (a skirt's ring is
         // 56-72 points: 7-9 % of 800); the weld then takes up to 4 % (the trousers' crotch).
         const double n = static_cast<double>(m.positions.size());
@@ -280,29 +296,14 @@ TEST(GarmentTemplateResolution, ExtremeBodiesAndParametersGiveConsistentManifold
               std::snprintf(name, sizeof name, "%s on %.2f m, BMI %.0f, ease %.3f, length %.1f, %d particles",
                             garmentKindName(kind), height, bmi, ease, length, target);
               ASSERT_TRUE(makeGarmentTemplate(body.model, p, m, err)) << name << ": " << err;
-              std::map<std::pair<uint32_t, uint32_t>, int> directed, undirected;
-              std::vector<char> used(m.positions.size(), 0);
-              int slivers = 0;
-              for (size_t t = 0; t < m.indices.size(); t += 3) {
-                const Vec3 &a = m.positions[m.indices[t]], &b = m.positions[m.indices[t + 1]],
-                           &c = m.positions[m.indices[t + 2]];
-                slivers += !(0.5f * (b - a).cross(c - a).norm() >= 1e-12f);  // what the topology refuses
-                for (size_t k = 0; k < 3; ++k) {
-                  const uint32_t u = m.indices[t + k], v = m.indices[t + (k + 1) % 3];
-                  used[u] = 1;
-                  ++directed[{u, v}];
-                  ++undirected[{std::min(u, v), std::max(u, v)}];
-                }
-              }
-              int shared = 0, twice = 0, finite = 0;
-              for (const auto& [e, n] : undirected) shared += n > 2;
-              for (const auto& [e, n] : directed) twice += n != 1;
+              const MeshEdgeUse use = meshEdgeUse(m);
+              int finite = 0;
               for (const Vec3& x : m.positions) finite += x.allFinite();
-              EXPECT_EQ(shared, 0) << name << ": edges in more than two triangles";
-              EXPECT_EQ(twice, 0) << name << ": a directed edge used twice";
-              EXPECT_EQ(slivers, 0) << name;
+              EXPECT_EQ(use.shared, 0) << name << ": edges in more than two triangles";
+              EXPECT_EQ(use.twice, 0) << name << ": a directed edge used twice";
+              EXPECT_EQ(use.slivers, 0) << name;
               EXPECT_EQ(finite, static_cast<int>(m.positions.size())) << name;
-              EXPECT_EQ(std::count(used.begin(), used.end(), 0), 0) << name << ": vertices in no triangle";
+              EXPECT_EQ(use.unused, 0) << name << ": vertices in no triangle";
               EXPECT_FALSE(m.pinned.empty()) << name;
               ++cases;
             }

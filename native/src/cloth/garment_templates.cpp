@@ -711,18 +711,17 @@ bool weldShortEdges(GarmentMesh& m, float tol, std::vector<uint32_t>* record = n
   // both ways, a zero-area fin on an edge of four triangles. Both copies go (the vertex only they
   // used goes with them below), which leaves the surface round them a manifold.
   {
+    std::vector<std::array<uint32_t, 3>> keys(tris.size() / 3);
     std::map<std::array<uint32_t, 3>, int> seen;
-    for (size_t t = 0; t < tris.size(); t += 3) {
-      std::array<uint32_t, 3> k{tris[t], tris[t + 1], tris[t + 2]};
-      std::sort(k.begin(), k.end());
-      ++seen[k];
+    for (size_t t = 0; t < keys.size(); ++t) {
+      keys[t] = {tris[3 * t], tris[3 * t + 1], tris[3 * t + 2]};
+      std::sort(keys[t].begin(), keys[t].end());
+      ++seen[keys[t]];
     }
     size_t kept = 0;
-    for (size_t t = 0; t < tris.size(); t += 3) {
-      std::array<uint32_t, 3> k{tris[t], tris[t + 1], tris[t + 2]};
-      std::sort(k.begin(), k.end());
-      if (seen[k] > 1) continue;
-      for (size_t j = 0; j < 3; ++j) tris[kept + j] = tris[t + j];
+    for (size_t t = 0; t < keys.size(); ++t) {
+      if (seen[keys[t]] > 1) continue;
+      for (size_t j = 0; j < 3; ++j) tris[kept + j] = tris[3 * t + j];
       kept += 3;
     }
     tris.resize(kept);

@@ -77,7 +77,7 @@ inline bool closestInsideFloat(const Vec4& b, const Vec4& e, const Vec4& q, floa
     r = (b.array() + t + Eigen::Array4f(0, 0, 0, 1)).inverse();
     const Eigen::Array4f u = a.array() * r;
     F = (u * u).sum() - 1.0f;
-    if (std::fabs(F) < 1e-5f) {
+    if (std::fabs(F) < kExactConvergedF) {
       // Just inside (F < 0: the first step lands there): out to just outside, as far as Newton's
       // steps on F leave a point (they land outside), so contacts rest on the same side.
       const float out = F < 0.0f ? 1.0f - F : 1.0f;

@@ -23,6 +23,11 @@ namespace collision_internal {
 // than 45 degrees (round the unit sphere) away from it.
 constexpr float kDeepContactCos = 0.70710678f;
 
+// The exact contact's float Newton iteration (closestInsideFloat and its batch) stops at |F| below
+// this: the point on the surface to 5e-6 of its radius (opencl/collide.cl's closest_inside_float
+// holds the same value as a literal).
+constexpr float kExactConvergedF = 1e-5f;
+
 inline int lowestBit(uint64_t m) {
 #if defined(_MSC_VER)
   unsigned long index = 0;
