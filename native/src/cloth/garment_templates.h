@@ -19,7 +19,7 @@ enum class GarmentKind : int { TShirt = 0, LongSleeve = 1, Skirt = 2, Dress = 3,
 
 struct GarmentTemplateParams {
   GarmentKind kind = GarmentKind::TShirt;
-  int target_particles = 2000;  // [200, 200000]; the result is within -4.5 / +2.5 % from 1 000 up
+  int target_particles = 2000;  // [200, 200000]; the result is within -5 / +2.5 % from 1 000 up
                                 // (a ring of points is a larger step below that: within 10 %)
   float ease_m = 0.025f;        // clearance over the body, [0.002, 0.1] m (see docs/garments.md)
   float length_scale = 1.0f;    // scales hem / sleeve / leg lengths, [0.5, 1.5]
