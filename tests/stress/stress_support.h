@@ -86,7 +86,9 @@ inline bool loadTake(const std::string& path, Take& take, std::string& err) {
   }
 
 // The scenarios dress a 1 000-particle T-shirt; DRAPE_STRESS_PARTICLES=N (>= 200) dresses another
-// resolution, to see how much a figure depends on it (docs/robustness.md, "Sensitivity").
+// resolution, to see how much a figure depends on it (docs/robustness.md, "Sensitivity"). Below
+// about 300 a T-shirt's limbs leave their tubes on the shared takes (docs/cloth-solver.md, "Coarse
+// garments come off"); StressLoop.ReplayLoopTenMinutes fails its worst-frame bound at 200 (not drift).
 // Under the sanitizers (preset asan) the default is `under_sanitizers`: 200 particles for the
 // scenarios that disturb the input (frame times, teleports, jitter, lost tracking, bad bones, bad
 // input, an upside-down skeleton), which check how the pipeline takes the disturbance and recovers
