@@ -125,7 +125,7 @@ void replayByKind(const std::string& path, GarmentKind kind, uint32_t particles,
   ASSERT_TRUE(readRecordingFile(path, 0, rec, err)) << err;
   Context ctx(test::defaultDesc());  // garment_fit: the shape's, as by default
   const Context::RestCut cut = ctx.cutFor(DRAPE_GARMENT_CUT_BY_KIND, garmentReachesLimbEnds(kind));
-  ASSERT_EQ(cut, Context::kCutSkeleton);
+  if (garmentReachesLimbEnds(kind)) ASSERT_EQ(cut, Context::kCutSkeleton);
   GarmentTemplateParams tp;
   tp.kind = kind;
   tp.target_particles = particles;
@@ -197,6 +197,40 @@ TEST_P(LongSleeveByKindOnRecording, KeepsItsSleevesOnAHoppingPerson) { expectSle
 // "A closer cuff") it stays on. Off in 39 and 41 of the 100 measured frames at the full ease, 1 and
 // 0 now.
 TEST_P(LongSleeveByKindOnRecording, KeepsItsSleevesAtFifteenHundredParticles) { expectSleevesOn(1500); }
+
+// Coarse garments: the smallest count of each kind that stays on the limbs over the shared takes
+// (drape.h at `particles`; docs/cloth-solver.md, "Coarse garments come off"), on Ges04 (a person
+// beckoning, arms raised and lowered), the whole take, every third frame measured. Below these
+// counts the limbs leave their tubes on this take: the long-sleeve at 500 particles in 48 of the 58
+// measured frames of the take's first 300, the T-shirt at 200 in 37, the dress at 300 in 32 (the
+// quality matrix at 200-800, tree 90cda92). Release only (asan_slow: its instances are named Ges04*).
+struct CoarseGarment {
+  GarmentKind kind;
+  uint32_t particles;
+  const char* name;
+};
+
+class CoarseGarmentOnRecording : public ::testing::TestWithParam<CoarseGarment> {};
+
+TEST_P(CoarseGarmentOnRecording, StaysOnAtTheDocumentedFloor) {
+  DRAPE_REQUIRE_SHARED(path, "kinect_v2_msft_labanotation/Ges04_comehere.csv");
+  ByKindRun run;
+  ASSERT_NO_FATAL_FAILURE(replayByKind(path, GetParam().kind, GetParam().particles, SIZE_MAX, run));
+  std::printf("[ figures  ] Ges04: %s at %u particles off in %d of %d measured frames\n", GetParam().name,
+              GetParam().particles, run.off, run.measured);
+  EXPECT_GT(run.measured, 50);
+  EXPECT_EQ(run.off, 0) << "an opening off its body part";
+}
+
+INSTANTIATE_TEST_SUITE_P(SharedData, CoarseGarmentOnRecording,
+                         ::testing::Values(CoarseGarment{GarmentKind::LongSleeve, 800, "longsleeve"},
+                                           CoarseGarment{GarmentKind::Trousers, 500, "trousers"},
+                                           CoarseGarment{GarmentKind::Dress, 500, "dress"},
+                                           CoarseGarment{GarmentKind::Skirt, 500, "skirt"},
+                                           CoarseGarment{GarmentKind::TShirt, 300, "tshirt"}),
+                         [](const ::testing::TestParamInfo<CoarseGarment>& info) {
+                           return std::string("Ges04_") + info.param.name;
+                         });
 
 INSTANTIATE_TEST_SUITE_P(SharedData, LongSleeveByKindOnRecording,
                          ::testing::Values("cmu_mocap_bvh/131_03.bvh", "cmu_mocap_bvh/scaled_131_03.bvh"),
