@@ -201,9 +201,11 @@ TEST_P(LongSleeveByKindOnRecording, KeepsItsSleevesAtFifteenHundredParticles) { 
 // Coarse garments: the smallest count of each kind that stays on the limbs over the shared takes
 // (drape.h at `particles`; docs/cloth-solver.md, "Coarse garments come off"), on Ges04 (a person
 // beckoning, arms raised and lowered), the whole take, every third frame measured. Below these
-// counts the limbs leave their tubes on this take: the long-sleeve at 500 particles in 48 of the 58
-// measured frames of the take's first 300, the T-shirt at 200 in 37, the dress at 300 in 32 (the
-// quality matrix at 200-800, tree 90cda92). Release only (asan_slow: its instances are named Ges04*).
+// counts the limbs leave their tubes on this take: the long-sleeve at 400 particles in 44 of the 58
+// measured frames, the T-shirt at 200 in 37, the dress at 300 in 32. The long-sleeve's floor was 800
+// until its rings along the sleeve were bounded by the cuff (garment_templates.cpp,
+// kBentSleeveRingsPerCuffPerimeter): at 500 it was off in 48 here. Release only (asan_slow: its
+// instances are named Ges04*).
 struct CoarseGarment {
   GarmentKind kind;
   uint32_t particles;
@@ -223,7 +225,7 @@ TEST_P(CoarseGarmentOnRecording, StaysOnAtTheDocumentedFloor) {
 }
 
 INSTANTIATE_TEST_SUITE_P(SharedData, CoarseGarmentOnRecording,
-                         ::testing::Values(CoarseGarment{GarmentKind::LongSleeve, 800, "longsleeve"},
+                         ::testing::Values(CoarseGarment{GarmentKind::LongSleeve, 500, "longsleeve"},
                                            CoarseGarment{GarmentKind::Trousers, 500, "trousers"},
                                            CoarseGarment{GarmentKind::Dress, 500, "dress"},
                                            CoarseGarment{GarmentKind::Skirt, 500, "skirt"},

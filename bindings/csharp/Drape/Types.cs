@@ -556,7 +556,7 @@ namespace Drape
         /// <summary>kind (int32_t in C); default <see cref="GarmentKind.TShirt"/>.</summary>
         public GarmentKind Kind;
         /// <summary>particles: target particle count, [200, 200000] (the result is within -5 / +2.5 % from 1000 up, 10 % below); default 2000.
-        /// Coarser than about 800 (long sleeve), 500 (trousers, dress, skirt) or 300 (T-shirt), limbs leave their tubes
+        /// Coarser than about 500 (long sleeve, trousers, dress, skirt) or 300 (T-shirt), limbs leave their tubes
         /// on the shared takes (docs/cloth-solver.md, "Coarse garments come off").</summary>
         public uint Particles;
         /// <summary>ease_m: clearance over the body, [0.002, 0.1]; default 0.025 (a long sleeve: 2 cm more at the

@@ -502,8 +502,8 @@ typedef struct drape_garment_template {
   int32_t kind;          /* drape_garment_kind; default DRAPE_GARMENT_TSHIRT */
   uint32_t particles;    /* target particle count, [200, 200000]; 2000. The result is
                             within -5 / +2.5 % from 1000 up, 10 % below. Coarser than about
-                            800 (long sleeve), 500 (trousers, dress, skirt) or 300 (T-shirt),
-                            limbs leave their tubes on the shared takes (docs/cloth-solver.md,
+                            500 (long sleeve, trousers, dress, skirt) or 300 (T-shirt), limbs
+                            leave their tubes on the shared takes (docs/cloth-solver.md,
                             "Coarse garments come off") */
   float ease_m;          /* clearance over the body, [0.002, 0.1]; 0.025 (a long sleeve: 2 cm more
                             at the armhole, tapering to 0.6 of it at the cuff) */

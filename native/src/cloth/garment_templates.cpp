@@ -44,6 +44,19 @@ constexpr float kLongSleeveCuffU = 1.75f;
 // price is a closer forearm that stretches more (P99 stretch 1.17 times; in the run looked at,
 // the added edge-frames above it lie on the forearm and cuff): docs/garments.md, "A closer cuff".
 constexpr float kLongSleeveCuffEaseScale = 0.6f;
+// The long-sleeve's rings along the sleeve at most a tenth of the cuff's perimeter apart (about
+// 2.9 cm on the default body), however coarse the rest of the garment, as long as a sleeve then
+// takes at most kBentSleeveMostShare of the particles asked for. Why: where the elbow bends, the
+// forearm's rounded end pushes at the sleeve between two rings; rings 4.6 cm apart (a 500-particle
+// long sleeve) let it through the sleeve's wall and the sleeve stayed down on the hip while the
+// arm rose, off in 423 of the quality matrix's 664 measured frames at 500 particles and 235 at 600
+// (14 at 800, where rings were 3.3 cm apart); with this bound 18 and 4 (docs/cloth-solver.md,
+// "Coarse garments come off"). A larger share (0.3) kept the 400-particle sleeve on too, but the
+// 200-particle garment then landed 11.5 % under its count (the torso has a least size). At 2 000
+// particles and up the rings are closer than the bound; it still moves the h search's first
+// builds there, so those meshes differ a little (64 runs at 1 000-2 400: docs/cloth-solver.md).
+constexpr float kBentSleeveRingsPerCuffPerimeter = 10.0f;
+constexpr float kBentSleeveMostShare = 0.25f;
 
 struct Sec {
   Vec3 c = Vec3::Zero();
@@ -214,7 +227,8 @@ class Builder {
         break;
       case GarmentKind::LongSleeve:
         upper(h, 0.05f * p_.length_scale + hipDrop_, false,
-              Sleeve{std::min(2.0f, kLongSleeveCuffU * p_.length_scale), kLongSleeveRootEaseM, kLongSleeveCuffEaseScale},
+              Sleeve{std::min(2.0f, kLongSleeveCuffU * p_.length_scale), kLongSleeveRootEaseM, kLongSleeveCuffEaseScale,
+                     true},
               m);
         break;
       case GarmentKind::Dress:
@@ -476,7 +490,30 @@ class Builder {
     float u;
     float root_ease_m = 0.0f;
     float cuff_ease_scale = 1.0f;
+    bool past_elbow = false;  // rings along it bounded by the cuff (kBentSleeveRingsPerCuffPerimeter)
   };
+
+  // The spacing between a sleeve's rings along the arm: the garment's (h * along_), and for a
+  // sleeve past the elbow at most its cuff's perimeter / kBentSleeveRingsPerCuffPerimeter, unless
+  // that would give the sleeve more than kBentSleeveMostShare of the target's particles (K per ring),
+  // where it is as close as that share allows.
+  float sleeveSpacing(float h, const std::function<Sec(float)>& path, int K, const Sleeve& sl) const {
+    const float plain = h * along_;
+    if (!sl.past_elbow) return plain;
+    const float bound = secPerimeter(path(1.0f)) / kBentSleeveRingsPerCuffPerimeter;
+    if (plain <= bound) return plain;
+    const float rings = kBentSleeveMostShare * static_cast<float>(p_.target_particles) / static_cast<float>(K);
+    if (rings < 2.0f) return plain;
+    constexpr int kFine = 64;
+    float length = 0.0f;
+    Vec3 prev = path(0.0f).c;
+    for (int i = 1; i <= kFine; ++i) {
+      const Vec3 c = path(static_cast<float>(i) / kFine).c;
+      length += (c - prev).norm();
+      prev = c;
+    }
+    return std::min(plain, std::max(bound, length / (rings - 1.0f)));
+  }
 
   // Torso tube (hem below the hip -> armpit ring T), yoke strips to the neck base ring N, and
   // the sleeves. Pins: collar ring, shoulder-seam tops (and waist for dresses).
@@ -558,7 +595,7 @@ class Builder {
       auto apath = [&](float v) {
         return chainSec(body_, arm, v * sl.u, e + sl.root_ease_m * (1.0f - v) + (sl.cuff_ease_scale - 1.0f) * e * v);
       };
-      const std::vector<Loop> sleeve = tube(m, samplePath(apath, h * along_, counter()), Ka);
+      const std::vector<Loop> sleeve = tube(m, samplePath(apath, sleeveSpacing(h, apath, Ka, sl), counter()), Ka);
       stitch(loop, sleeve.front(), m);
       // Shoulder-seam top: the sleeve's first-ring points highest along the torso's up axis.
       const Vec3 up_axis = T.f.col(1);
