@@ -271,7 +271,7 @@ TEST(GarmentTemplateResolution, EveryCountIsAConsistentManifoldNearTheTarget) {
 // The coarse end, 200-800 particles, where the contract is 10 %. Until the rows along the tubes
 // could come as close as 0.6 of the spacing round there (kLeastAlongBelow1000), a ring's step left
 // counts 11-19 % short (on the default body: a 255-particle skirt 208, 310-particle trousers 251;
-// with this grid 6 of its builds failed). A long sleeve's rings along the forearm are bounded there
+// 20 of this test's builds fail with 0.8). A long sleeve's rings along the forearm are bounded there
 // (kBentSleeveRingsPerCuffPerimeter) while a sleeve takes at most a quarter of the count; a larger
 // share (0.3) left the 200-particle long sleeve at 0.885 of it.
 TEST(GarmentTemplateResolution, CoarseCountsAreConsistentManifoldsWithinTenPercent) {

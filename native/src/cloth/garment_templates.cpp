@@ -905,8 +905,9 @@ bool makeGarmentTemplate(const BodyModel& body, const GarmentTemplateParams& p, 
     // every row (the 2 000-particle T-shirt: 1 810 or 2 094 particles, nothing between). So first
     // h, adjusted until the count is within 4 % of the target or, after 12 builds, the closest
     // count seen; then, where that is more than 1 % off, the spacing between rings along the tubes
-    // (`along` x h, in [0.8, 1], [0.6, 1] below 1 000 particles: kLeastAlongBelow1000; the count falls as it grows) bisected to within 1 % (the closest
-    // seen after 10 builds), from below the target (below). The layout is recorded only for a
+    // (`along` x h, in [0.8, 1], or [0.6, 1] below 1 000 particles: kLeastAlongBelow1000; the count
+    // falls as it grows) bisected to within 1 % (the closest seen after 10-11 builds), from below
+    // the target (below). The layout is recorded only for a
     // caller that keeps it; the last build is the one recorded.
     builder.setLayout(record ? &layout : nullptr, nullptr);
     const float target = static_cast<float>(p.target_particles);
