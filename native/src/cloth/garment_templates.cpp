@@ -166,17 +166,24 @@ int roundTo(float v, int multiple, int minimum) {
   return std::max(minimum, k);
 }
 
+// The arc length of a path s in [0, 1] from its start to s = i / fine, i in [0, fine], along the
+// polyline through those fine + 1 sections' centres.
+std::vector<float> arcLengths(const std::function<Sec(float)>& path, int fine) {
+  std::vector<float> cum(static_cast<size_t>(fine) + 1, 0.0f);
+  Vec3 prev = path(0.0f).c;
+  for (int i = 1; i <= fine; ++i) {
+    const Vec3 c = path(static_cast<float>(i) / static_cast<float>(fine)).c;
+    cum[static_cast<size_t>(i)] = cum[static_cast<size_t>(i) - 1] + (c - prev).norm();
+    prev = c;
+  }
+  return cum;
+}
+
 // Sections along a path s in [0, 1], evenly spaced in arc length by about h (at least 2); `count`
 // may replace that number (Builder::count).
 std::vector<Sec> samplePath(const std::function<Sec(float)>& path, float h, const std::function<int(int)>& count) {
   constexpr int kFine = 128;
-  std::vector<float> cum(kFine + 1, 0.0f);
-  Vec3 prev = path(0.0f).c;
-  for (int i = 1; i <= kFine; ++i) {
-    const Vec3 c = path(static_cast<float>(i) / kFine).c;
-    cum[i] = cum[i - 1] + (c - prev).norm();
-    prev = c;
-  }
+  const std::vector<float> cum = arcLengths(path, kFine);
   const float L = cum[kFine];
   const int rings = std::max(2, count(std::max(2, static_cast<int>(std::lround(L / h)) + 1)));
   std::vector<Sec> out;
@@ -512,14 +519,7 @@ class Builder {
     if (plain <= bound) return plain;
     const float rings = kBentSleeveMostShare * static_cast<float>(p_.target_particles) / static_cast<float>(K);
     if (rings < 2.0f) return plain;
-    constexpr int kFine = 64;
-    float length = 0.0f;
-    Vec3 prev = path(0.0f).c;
-    for (int i = 1; i <= kFine; ++i) {
-      const Vec3 c = path(static_cast<float>(i) / kFine).c;
-      length += (c - prev).norm();
-      prev = c;
-    }
+    const float length = arcLengths(path, 64).back();
     return std::min(plain, std::max(bound, length / (rings - 1.0f)));
   }
 
@@ -907,8 +907,8 @@ bool makeGarmentTemplate(const BodyModel& body, const GarmentTemplateParams& p, 
     // count seen; then, where that is more than 1 % off, the spacing between rings along the tubes
     // (`along` x h, in [0.8, 1], or [0.6, 1] below 1 000 particles: kLeastAlongBelow1000; the count
     // falls as it grows) bisected to within 1 % (the closest seen after 10-11 builds), from below
-    // the target (below). The layout is recorded only for a
-    // caller that keeps it; the last build is the one recorded.
+    // the target (below). The layout is recorded only for a caller that keeps it; the last build
+    // is the one recorded.
     builder.setLayout(record ? &layout : nullptr, nullptr);
     const float target = static_cast<float>(p.target_particles);
     float built_h = 0.0f, built_along = 0.0f;  // the last build's
