@@ -1,7 +1,8 @@
 # Runs drape-bench --quick into OUT_DIR and checks what it wrote: every sweep's CSV exists and
 # parses (same field count on every row, the header's columns), every numeric field is a finite
 # number, the pairs that must be ordered are (p90 >= median, max >= P99, max deviation >= RMS),
-# the Bullet peer CSV exists when Bullet was built in, the PNGs exist when gnuplot is installed,
+# the converged references' CSV has their measured errors, the Bullet peer CSV exists when Bullet
+# was built in, the PNGs exist when gnuplot is installed,
 # and summary.md names the paper's Table 1.
 # Usage: cmake -DEXE=... -DOUT_DIR=... -DEXPECT_BULLET=ON|OFF -P check_bench.cmake
 file(REMOVE_RECURSE "${OUT_DIR}")
@@ -70,6 +71,22 @@ foreach(sweep solver substeps iterations strain_limit ring_points contact_respon
   endif()
 endforeach()
 check_csv("${OUT_DIR}/table1.csv" 6)
+# The converged references' own errors: one per model the sweeps ran (solver, K, contact response,
+# continuous collision, resolution), so more than one; each measured (a finite, non-zero stretch).
+check_csv("${OUT_DIR}/references.csv" 6)
+if(_rows LESS 2)
+  message(FATAL_ERROR "references.csv: expected a reference per model swept, got ${_rows}")
+endif()
+file(STRINGS "${OUT_DIR}/references.csv" _refs)
+list(GET _refs 0 _head)
+string(REPLACE "," ";" _head "${_head}")
+list(FIND _head "stretch_p99_pct" _c_stretch)
+list(GET _refs 1 _first_ref)
+string(REPLACE "," ";" _first_ref "${_first_ref}")
+list(GET _first_ref ${_c_stretch} _ref_stretch)
+if(NOT _ref_stretch GREATER 0)
+  message(FATAL_ERROR "references.csv: the first reference was not measured (stretch P99 ${_ref_stretch} %)")
+endif()
 if(EXPECT_BULLET)
   check_csv("${OUT_DIR}/bullet_peer.csv" 3)
   if(NOT _rows EQUAL 3)
@@ -92,7 +109,7 @@ if(EXPECT_BULLET)
   endif()
 endif()
 file(READ "${OUT_DIR}/summary.md" summary)
-foreach(needle "Table 1" "NvCloth" "Bullet")
+foreach(needle "Table 1" "NvCloth" "Bullet" "converged references")
   string(FIND "${summary}" "${needle}" at)
   if(at LESS 0)
     message(FATAL_ERROR "summary.md does not mention '${needle}'")

@@ -64,7 +64,8 @@ const char* kHelp =
     "                   [--peer-spread N]\n"
     "                   [--no-plots]\n"
     "Sweeps Drape's speed/accuracy settings over real takes and writes, into DIR (default\n"
-    "drape-bench-out): <sweep>.csv and <sweep>.png per sweep, bullet_peer.csv, summary.md.\n"
+    "drape-bench-out): <sweep>.csv and <sweep>.png per sweep, table1.csv, references.csv (the\n"
+    "converged references' own errors), bullet_peer.csv, summary.md.\n"
     "  --quick           a few points per sweep, one 1 s take, one repeat (CI: under a minute)\n"
     "  --take PATH@N     a recording (Kinect CSV, BVH, .drec), replaying every N-th frame;\n"
     "                    default: the shared Kinect take and the CMU BVH hop take at 60 Hz\n"
@@ -154,12 +155,38 @@ bool parse(int argc, char** argv, Options& o, std::string& err) {
   return true;
 }
 
+// A converged reference's row: its error figures by the settings' meters, no times (it is not
+// timed). Labelled by the setting that first asked for it: "reference of <label> (<sweep>)".
+Row referenceRow(const Take& take, const Setting& asked_by, const Setting& ref, const RunResult& rr) {
+  Row r;
+  r.setting = ref;
+  r.setting.label = "reference of " + asked_by.label + " (" + asked_by.sweep + ")";
+  r.take = take.name;
+  r.rate_hz = take.rate_hz;
+  r.particles = rr.particles;
+  r.substeps_per_frame = rr.substeps_per_frame;
+  r.stretch_p99 = rr.stretch_p99;
+  r.stretch_max = rr.stretch_max;
+  r.pen_p99_mm = rr.penetration_p99_mm;
+  r.pen_max_mm = rr.penetration_max_mm;
+  r.deeper_than_2mm = rr.deeper_than_2mm;
+  r.in_body = rr.in_body;
+  r.inside_mean = rr.inside_mean;
+  r.inside_max = rr.inside_max;
+  r.openings_off = rr.openings_off;
+  r.nan_resets = rr.nan_resets;
+  return r;
+}
+
 struct Runner {
   const Options& opt;
   int repeats;
   double energy_seconds;
   std::map<std::string, Row> done;              // key + take -> row
   std::map<std::string, RunResult> references;  // reference key + take
+  // The references' own error figures, in the order they were run: what the same model reaches
+  // when the solver has converged (summary.md, "What solver effort reaches").
+  std::vector<Row> reference_rows;
   std::map<std::string, EnergyDrift> energies;  // solver/hz/iterations/particles
 
   bool row(const Take& take, const Setting& s, Row& out, std::string& err) {
@@ -210,8 +237,10 @@ struct Runner {
       RunResult rr;
       RunOptions ro;
       ro.keep_positions = true;
+      ro.measure = true;  // by the same meters as the settings (outside any timed call)
       std::fprintf(stderr, "drape-bench:   reference %s ...\n", ref.key().c_str());
       if (!runDrape(take, ref, ro, rr, err)) return false;
+      reference_rows.push_back(referenceRow(take, s, ref, rr));
       references[ref_id] = std::move(rr);
     }
     const RunResult& rr = references[ref_id];
@@ -305,7 +334,7 @@ int run(int argc, char** argv) {
   report.command = commandLine(argc, argv);
   report.takes = takes;
   report.energy_seconds = energy_seconds;
-  Runner runner{opt, repeats, energy_seconds, {}, {}, {}};
+  Runner runner{opt, repeats, energy_seconds, {}, {}, {}, {}};
   for (const Sweep& sw : makeSweeps(opt.quick, true)) {
     if (!opt.sweeps.empty() && !opt.sweeps.count(sw.name)) continue;
     std::vector<Row> rows;
@@ -353,6 +382,11 @@ int run(int argc, char** argv) {
     report.table1.push_back(r);
   }
   if (!writeRowsCsv((fs::path(opt.out) / "table1.csv").string(), report.table1, err)) {
+    std::fprintf(stderr, "drape-bench: error: %s\n", err.c_str());
+    return kExitFailure;
+  }
+  report.references = runner.reference_rows;
+  if (!writeRowsCsv((fs::path(opt.out) / "references.csv").string(), report.references, err)) {
     std::fprintf(stderr, "drape-bench: error: %s\n", err.c_str());
     return kExitFailure;
   }

@@ -50,6 +50,51 @@ const Row* defaultRow(const ReportInput& in, const std::string& take) {
   return nullptr;
 }
 
+// The converged reference that prices `s` (the same model: every knob but substeps, iterations,
+// the strain limit and the backend, which the references share; main.cpp's Runner::row).
+const Row* referenceFor(const ReportInput& in, const Row& r) {
+  for (const Row& ref : in.references) {
+    const Setting &a = ref.setting, &b = r.setting;
+    if (ref.take == r.take && a.solver == b.solver && a.ring_points == b.ring_points && a.proxy_rule == b.proxy_rule &&
+        a.contact_response == b.contact_response && a.continuous_collision == b.continuous_collision &&
+        a.particles == b.particles)
+      return &ref;
+  }
+  return nullptr;
+}
+
+// What solver effort reaches: each converged reference's own error figures (references.csv), and
+// Drape's default against its reference and against the targets that solver effort cannot buy.
+void renderReferences(const ReportInput& in, std::string& o) {
+  if (in.references.empty()) return;
+  o += "\n## What solver effort reaches: the converged references (`references.csv`)\n\n"
+       "Each reference is the same input at 16x the substeps and 4x the iterations (`--quick`: 4x and 2x), "
+       "measured by the same meters as the settings (not timed). One reference serves every setting that differs "
+       "from it only in substeps, iterations or strain limit; it is listed under the first setting that asked for "
+       "it. What a setting's error exceeds its reference's by is the solver's convergence; what the reference "
+       "itself shows belongs to the model (the garment's cut, its pins, friction, the body and its ellipsoids), "
+       "and more substeps or iterations do not take it away.\n\n"
+       "| converges | take | substeps per frame x iterations | stretch % P99 / max | penetration mm P99 / max | "
+       "> 2 mm % | in body % | off % | inside |\n|---|---|---|---|---|---|---|---|---|\n";
+  for (const Row& r : in.references)
+    appendf(o, "| %s | %s | %.0f x %u | %.2f / %.1f | %.2f / %.1f | %.3f | %.3f | %.0f | %.2f |\n",
+            r.setting.label.c_str(), r.take.c_str(), r.substeps_per_frame, r.setting.iterations,
+            100.0 * r.stretch_p99, 100.0 * r.stretch_max, r.pen_p99_mm, r.pen_max_mm, 100.0 * r.deeper_than_2mm,
+            100.0 * r.in_body, 100.0 * r.openings_off, r.inside_mean);
+  for (const Take& t : in.takes) {
+    const Row* d = defaultRow(in, t.name);
+    const Row* ref = d ? referenceFor(in, *d) : nullptr;
+    if (!d || !ref) continue;
+    appendf(o,
+            "\nOn `%s`, Drape's default: stretch P99 %.2f %% against its converged reference's %.2f %% (the goal, "
+            "ANCHORS.md: 5 %%; %s), cloth in the body %.2f %% against %.2f %% (NvCloth: %.2f %%; %s).\n",
+            t.name.c_str(), 100.0 * d->stretch_p99, 100.0 * ref->stretch_p99,
+            ref->stretch_p99 > 0.05 ? "above it in the reference too" : "the reference is below it",
+            100.0 * d->in_body, 100.0 * ref->in_body, 100.0 * kNvClothInsideBody,
+            ref->in_body >= kNvClothInsideBody ? "not less in the reference either" : "the reference is less");
+  }
+}
+
 // --peer-spread: per take, Bullet 4 x 10 (the peer's field) from its usual start and from the
 // seeds' starting shirts, against Drape's two settings (the same in every run: Drape's start is
 // not perturbed).
@@ -167,6 +212,8 @@ std::string renderReport(const ReportInput& in) {
               d->rate_hz, d->substeps_per_frame);
     }
   }
+
+  renderReferences(in, o);
 
   // The peer.
   o += "\n## Bullet soft body beside Drape, same run\n\n";

@@ -17,6 +17,7 @@ struct ReportInput {
   std::vector<Sweep> sweeps;
   std::vector<std::vector<Row>> rows;  // per sweep, same order
   std::vector<Row> table1;             // the default setting at ~2 000 particles, per take
+  std::vector<Row> references;         // the converged references' own error figures (not timed)
   std::vector<PeerResult> peers;       // on takes[0]
   std::vector<PeerResult> spread;      // --peer-spread: Bullet 4 x 10 from other starting shirts
   double peer_field_m = kBulletFieldM;  // the Bullet field the target is judged on
