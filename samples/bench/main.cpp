@@ -155,6 +155,22 @@ bool parse(int argc, char** argv, Options& o, std::string& err) {
   return true;
 }
 
+// A measuring run's figures into a row: its garment's size and its error figures.
+void takeFigures(const RunResult& m, Row& r) {
+  r.particles = m.particles;
+  r.substeps_per_frame = m.substeps_per_frame;
+  r.stretch_p99 = m.stretch_p99;
+  r.stretch_max = m.stretch_max;
+  r.pen_p99_mm = m.penetration_p99_mm;
+  r.pen_max_mm = m.penetration_max_mm;
+  r.deeper_than_2mm = m.deeper_than_2mm;
+  r.in_body = m.in_body;
+  r.inside_mean = m.inside_mean;
+  r.inside_max = m.inside_max;
+  r.openings_off = m.openings_off;
+  r.nan_resets = m.nan_resets;
+}
+
 // A converged reference's row: its error figures by the settings' meters, no times (it is not
 // timed). Labelled by the setting that first asked for it: "reference of <label> (<sweep>)".
 Row referenceRow(const Take& take, const Setting& asked_by, const Setting& ref, const RunResult& rr) {
@@ -163,18 +179,7 @@ Row referenceRow(const Take& take, const Setting& asked_by, const Setting& ref, 
   r.setting.label = "reference of " + asked_by.label + " (" + asked_by.sweep + ")";
   r.take = take.name;
   r.rate_hz = take.rate_hz;
-  r.particles = rr.particles;
-  r.substeps_per_frame = rr.substeps_per_frame;
-  r.stretch_p99 = rr.stretch_p99;
-  r.stretch_max = rr.stretch_max;
-  r.pen_p99_mm = rr.penetration_p99_mm;
-  r.pen_max_mm = rr.penetration_max_mm;
-  r.deeper_than_2mm = rr.deeper_than_2mm;
-  r.in_body = rr.in_body;
-  r.inside_mean = rr.inside_mean;
-  r.inside_max = rr.inside_max;
-  r.openings_off = rr.openings_off;
-  r.nan_resets = rr.nan_resets;
+  takeFigures(rr, r);
   return r;
 }
 
@@ -209,19 +214,8 @@ struct Runner {
     mo.measure = true;
     mo.keep_positions = true;
     if (!runDrape(take, s, mo, measured, err)) return false;
-    r.particles = measured.particles;
+    takeFigures(measured, r);
     r.device = measured.device;
-    r.substeps_per_frame = measured.substeps_per_frame;
-    r.stretch_p99 = measured.stretch_p99;
-    r.stretch_max = measured.stretch_max;
-    r.pen_p99_mm = measured.penetration_p99_mm;
-    r.pen_max_mm = measured.penetration_max_mm;
-    r.deeper_than_2mm = measured.deeper_than_2mm;
-    r.in_body = measured.in_body;
-    r.inside_mean = measured.inside_mean;
-    r.inside_max = measured.inside_max;
-    r.openings_off = measured.openings_off;
-    r.nan_resets = measured.nan_resets;
     // The converged reference of the same input, shared by every setting that differs only in
     // substeps and iterations.
     Setting ref_key_setting = s;
