@@ -6,7 +6,8 @@ namespace bench {
 
 bool bulletAvailable() { return false; }
 
-bool runBulletPeer(const Take&, uint32_t, int, int, double, PeerResult&, std::string& error, uint32_t) {
+bool runBulletPeer(const Take&, uint32_t, int, int, double, const PeerDriver&, PeerResult&, std::string& error,
+                   uint32_t) {
   error =
       "this drape-bench was built without Bullet (install libbullet-dev, e.g. bash .ci/install-deps.sh, and "
       "rebuild) so the peer comparison was skipped";

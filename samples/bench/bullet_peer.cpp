@@ -108,7 +108,7 @@ bool pushAndStep(drape_context* ctx, drape_garment* garment, const Take& take, s
 bool bulletAvailable() { return true; }
 
 bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, int iterations, double sdf_voxel_m,
-                   PeerResult& out, std::string& error, uint32_t start_seed) {
+                   const PeerDriver& driver, PeerResult& out, std::string& error, uint32_t start_seed) {
   out = PeerResult{};
   if (!(sdf_voxel_m >= 0.001 && sdf_voxel_m <= 10.0)) {
     error = "the distance-field voxel must be in [0.001, 10] m";
@@ -123,10 +123,12 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
   if (start_seed > 0) out.label += ", start seed " + std::to_string(start_seed);
   out.take = take.name;
   out.rate_hz = take.rate_hz;
+  out.driver = driver;
 
-  // The driver: Drape at its default setting, but for the garment's cut: Bullet gets the mesh and
-  // rest shape Drape starts with, so Drape keeps that cut too (DRAPE_GARMENT_FIT_SHAPE: no refit
-  // to the person's skeleton at calibration) and both simulate the same garment.
+  // The driver: Drape at the driver's setting, dressed at it (so Bullet starts from that setting's
+  // shirt), but for the garment's cut: Bullet gets the mesh and rest shape Drape starts with, so
+  // Drape keeps that cut too (DRAPE_GARMENT_FIT_SHAPE: no refit to the person's skeleton at
+  // calibration) and both simulate the same garment.
   drape_context_desc desc;
   drape_context_desc_init(&desc);
   desc.garment_fit = DRAPE_GARMENT_FIT_SHAPE;
@@ -136,11 +138,14 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
   drape_garment_template tmpl;
   drape_garment_template_init(&tmpl);
   tmpl.particles = particles;
-  drape_garment* garment = nullptr;
-  if (drape_result r = drape_context_add_garment_template(ctx.get(), nullptr, &tmpl, nullptr, &garment))
-    return failed("drape_context_add_garment_template", r, error);
   drape_cloth_params cloth;
   drape_cloth_params_init(&cloth);
+  if (driver.iterations > 0) cloth.iterations = driver.iterations;
+  if (driver.strain_limit >= 0.0f) cloth.strain_limit = driver.strain_limit;
+  if (driver.strain_limit_passes > 0) cloth.strain_limit_passes = driver.strain_limit_passes;
+  drape_garment* garment = nullptr;
+  if (drape_result r = drape_context_add_garment_template(ctx.get(), nullptr, &tmpl, &cloth, &garment))
+    return failed("drape_context_add_garment_template", r, error);
   uint32_t nv = 0, ni = 0, ne = 0, body_nv = 0, body_ni = 0;
   if (!ok("drape_garment_get_params", drape_garment_get_params(garment, &cloth), error) ||
       !ok("drape_garment_get_mesh_size", drape_garment_get_mesh_size(garment, &nv, &ni), error) ||
@@ -158,27 +163,6 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
     return false;
   std::vector<drape_ellipsoid> e_start(ne), e_end(ne);
 
-  // Beside the driver, a second Drape context at the setting with less stretch
-  // (kLessStretchLimit in kLessStretchPasses passes), the same garment on the same frames: timed
-  // and measured as the driver is, while Bullet still follows the driver alone.
-  drape_context* raw_less = nullptr;
-  if (drape_result r = drape_context_create(&desc, &raw_less)) return failed("drape_context_create", r, error);
-  std::unique_ptr<drape_context, ContextDeleter> ctx_less(raw_less);
-  drape_cloth_params less = cloth;
-  less.strain_limit = kLessStretchLimit;
-  less.strain_limit_passes = kLessStretchPasses;
-  drape_garment* garment_less = nullptr;
-  if (drape_result r = drape_context_add_garment_template(ctx_less.get(), nullptr, &tmpl, &less, &garment_less))
-    return failed("drape_context_add_garment_template", r, error);
-  uint32_t nv_less = 0, ni_less = 0;
-  if (!ok("drape_garment_get_mesh_size", drape_garment_get_mesh_size(garment_less, &nv_less, &ni_less), error))
-    return false;
-  if (nv_less != nv || ni_less != ni) {
-    error = "the less-stretch garment's mesh differs from the driver's";
-    return false;
-  }
-  std::vector<drape_vec3> x_less(nv);
-
   // The driver's frame: its garment, and what Bullet takes from it (ellipsoids, body mesh).
   auto pushStep = [&](size_t i, double& frame_ms, double& cloth_ms, double& cpu_ms) -> bool {
     uint32_t count = 0;
@@ -188,11 +172,8 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
            ok("drape_context_read_body_mesh",
               drape_context_read_body_mesh(ctx.get(), body.data(), nullptr, body_nv, nullptr, 0), error);
   };
-  auto pushStepLess = [&](size_t i, double& frame_ms, double& cloth_ms, double& cpu_ms) -> bool {
-    return pushAndStep(ctx_less.get(), garment_less, take, i, x_less, frame_ms, cloth_ms, cpu_ms, error);
-  };
   double frame_ms = 0, cloth_ms = 0, cpu_ms = 0;
-  if (!pushStep(0, frame_ms, cloth_ms, cpu_ms) || !pushStepLess(0, frame_ms, cloth_ms, cpu_ms)) return false;
+  if (!pushStep(0, frame_ms, cloth_ms, cpu_ms)) return false;
   std::vector<uint8_t> pinned(nv, 0);
   {
     const float* xyzw = nullptr;
@@ -271,11 +252,11 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
     w.bodies.push_back(std::move(body_rb));
   }
 
-  // Bullet's garment, Drape's default and Drape's setting with less stretch.
-  GarmentMeters m_bullet, m_drape, m_less;
-  for (GarmentMeters* m : {&m_bullet, &m_drape, &m_less}) {
+  // Bullet's garment and the driver's.
+  GarmentMeters m_bullet, m_drape;
+  for (GarmentMeters* m : {&m_bullet, &m_drape}) {
     m->stretch.setMesh(indices, rest);
-    m->openings.bind(indices, x.data(), nv, e_end);  // the driver's dressed garment, which all three start from
+    m->openings.bind(indices, x.data(), nv, e_end);  // the driver's dressed garment, which both start from
   }
   BodySurface surface;
   std::vector<drape_vec3> pin_start(nv);
@@ -283,19 +264,10 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
     e_start = e_end;
     for (uint32_t k = 0; k < nv; ++k)
       if (pinned[k]) pin_start[k] = x[k];
-    // The two Drape contexts take turns to run first, right after Bullet's step: the one that
-    // follows the other finds the library's code and tables warm, which is worth ~0.1 ms a frame
-    // here (docs/benchmarks.md).
-    double less_frame_ms = 0, less_cloth_ms = 0, less_cpu_ms = 0;
-    if (i % 2 == 1 && !pushStepLess(i, less_frame_ms, less_cloth_ms, less_cpu_ms)) return false;
     if (!pushStep(i, frame_ms, cloth_ms, cpu_ms)) return false;
-    if (i % 2 == 0 && !pushStepLess(i, less_frame_ms, less_cloth_ms, less_cpu_ms)) return false;
     out.drape.ms.push_back(cloth_ms);
     out.drape.frame_ms.push_back(frame_ms);
     out.drape.cpu_ms.push_back(cpu_ms);
-    out.drape_less.ms.push_back(less_cloth_ms);
-    out.drape_less.frame_ms.push_back(less_frame_ms);
-    out.drape_less.cpu_ms.push_back(less_cpu_ms);
     const double dt = take.timestamps_s[i] - take.timestamps_s[i - 1];
     const int n = std::max(1, static_cast<int>(std::lround(dt * rate)));
     const btScalar h = static_cast<btScalar>(dt / n);
@@ -340,18 +312,15 @@ bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, 
       bx[k] = drape_vec3{static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
       if (!std::isfinite(bx[k].x) || !std::isfinite(bx[k].y) || !std::isfinite(bx[k].z)) out.bullet.finite = false;
     }
-    // One body for all three: the two Drape contexts track the same frames the same way.
     if (!surface.set(body, body_idx)) {
       error = "the body mesh could not be measured";
       return false;
     }
     if (out.bullet.finite) m_bullet.addFrame(surface, bx.data(), nv, pinned, e_end);
     m_drape.addFrame(surface, x.data(), nv, pinned, e_end);
-    m_less.addFrame(surface, x_less.data(), nv, pinned, e_end);
   }
   m_bullet.finish(out.bullet);
   m_drape.finish(out.drape);
-  m_less.finish(out.drape_less);
   return true;
 }
 

@@ -1,10 +1,13 @@
 // The peer in the same run: Bullet's soft-body cloth (Debian libbullet-dev, 3.24) dressed in the
 // same T-shirt mesh on the same body, replayed over the same take at the same frame rate.
 //
-// A Drape context runs alongside as the driver: it tracks the body, builds the tracking ellipsoids
-// and the body mesh, and its own garment (the default setting) gives the attachment targets (its
-// pinned particles end every step at their targets) and the starting shape (the garment once placed
-// on the first tracked pose). Bullet gets: a soft body made from the garment's rest positions and
+// A Drape context runs alongside as the driver, at one of Drape's settings (peerDrivers()): it
+// tracks the body, builds the tracking ellipsoids and the body mesh, and its garment gives the
+// attachment targets (its pinned particles end every step at their targets) and the starting shape
+// (the garment dressed at that setting and placed on the first tracked pose). Bullet's stretch
+// follows the shirt it starts from (a point less from a less stretched one: docs/benchmarks.md,
+// "Bullet inherits the driver's shirt"), so each Drape setting is compared with Bullet started
+// from that setting's own shirt. Bullet gets: a soft body made from the garment's rest positions and
 // triangles (links from the edges, bending constraints at distance 2, the same mass: 0.2 kg/m^2),
 // its attached nodes as kinematic nodes moved to the same targets across the substeps, each
 // tracking ellipsoid as a kinematic btMultiSphereShape (one unit sphere, scaled by the radii) moved
@@ -48,12 +51,23 @@ struct PeerSide {
 // shirt on the body (docs/benchmarks.md); Bullet's own default is 0.25 m.
 constexpr double kBulletFieldM = 0.05;
 constexpr double kBulletDefaultFieldM = 0.25;
-// Drape's setting with less stretch beside its default (docs/garments.md, "More strain-limit
-// passes"; Unity's DrapeDresser.lessStretch): the strain limit at 5 % in 8 passes.
+// A Drape setting that drives the peer: the library's defaults with these overrides (0 or a
+// negative strain limit: the library's default). Bullet starts from that setting's dressed shirt.
+struct PeerDriver {
+  std::string label;                 // e.g. "default", "strain limit 5 % x 8 passes"
+  uint32_t iterations = 0;           // drape_cloth_params.iterations
+  float strain_limit = -1.0f;        // drape_cloth_params.strain_limit
+  uint32_t strain_limit_passes = 0;  // drape_cloth_params.strain_limit_passes
+  bool isDefault() const { return iterations == 0 && strain_limit < 0.0f && strain_limit_passes == 0; }
+};
+// The setting with less stretch (docs/garments.md, "More strain-limit passes"; Unity's
+// DrapeDresser.lessStretch): the strain limit at 5 % in 8 passes.
 constexpr float kLessStretchLimit = 0.05f;
 constexpr uint32_t kLessStretchPasses = 8;
-// "strain limit 5 % x 8 passes": that setting's name in bullet_peer.csv and summary.md.
-std::string lessStretchLabel();
+// The settings the peer compares with Bullet 4 x 10 on its field, each from its own shirt:
+// Drape's default; the strain limit at 5 % in 8 passes; the same with 2 iterations per substep
+// (docs/benchmarks.md, "Each setting against Bullet from its own shirt"). The first is the default.
+std::vector<PeerDriver> peerDrivers();
 
 struct PeerResult {
   std::string label;  // e.g. "4 x 10 (5 cm field)"
@@ -63,9 +77,8 @@ struct PeerResult {
   int iterations = 0;
   double sdf_voxel_m = 0;  // Bullet's distance-field voxel
   uint32_t particles = 0;
-  // drape: the default setting, which drives Bullet; drape_less: kLessStretchLimit in
-  // kLessStretchPasses passes, in its own context beside it.
-  PeerSide bullet, drape, drape_less;
+  PeerDriver driver;  // Drape's setting: drape below, and the shirt Bullet starts from
+  PeerSide bullet, drape;
 };
 
 // --peer-spread: Bullet's free nodes start shifted together this far (metres, a direction drawn
@@ -76,10 +89,10 @@ constexpr double kStartShiftM = 0.0005;
 
 // True when this drape-bench was built with Bullet.
 bool bulletAvailable();
-// Runs one Bullet setting beside Drape's default (the driver) and its setting with less stretch.
+// Runs one Bullet setting beside Drape at `driver`, Bullet starting from that setting's shirt.
 // start_seed > 0: Bullet's free nodes start shifted by kStartShiftM in a direction drawn from that
 // seed (the label says so); Drape is unchanged. false + error on failure.
 bool runBulletPeer(const Take& take, uint32_t particles, int substeps_per_60hz, int iterations, double sdf_voxel_m,
-                   PeerResult& out, std::string& error, uint32_t start_seed = 0);
+                   const PeerDriver& driver, PeerResult& out, std::string& error, uint32_t start_seed = 0);
 
 }  // namespace bench

@@ -48,7 +48,7 @@ struct Options {
   bool help = false;
   bool bullet = true;
   double bullet_field_m = bench::kBulletFieldM;  // the peer's distance-field voxel
-  int peer_spread = 0;  // extra Bullet 4 x 10 runs per peer take, each from another starting shirt
+  int peer_spread = 0;  // extra Bullet 4 x 10 runs per peer take and setting, each from another starting shirt
   bool plots = true;
   std::string out = "drape-bench-out";
   std::vector<TakeSpec> takes;
@@ -78,9 +78,10 @@ const char* kHelp =
     "  --no-bullet       skip the Bullet peer;  --no-plots  skip gnuplot\n"
     "  --bullet-field M  the Bullet peer's distance-field voxel in metres, [0.005, 1] (default 0.05;\n"
     "                    a full run also runs 4 x 10 at Bullet's own 0.25 and at 0.02)\n"
-    "  --peer-spread N   Bullet 4 x 10 N more times per peer take, its free nodes starting shifted\n"
-    "                    0.5 mm from where Drape placed them (seeds 1..N), [0, 20] (default 0):\n"
-    "                    the spread of Bullet's figures and how often Drape's are below them\n";
+    "  --peer-spread N   Bullet 4 x 10 N more times per peer take and Drape setting, its free nodes\n"
+    "                    starting shifted 0.5 mm from where Drape placed them (seeds 1..N), [0, 20]\n"
+    "                    (default 0): the spread of Bullet's figures and how often Drape's are below\n"
+    "                    them\n";
 
 bool parseNumber(const std::string& s, double lo, double hi, double& out) {
   char* end = nullptr;
@@ -388,7 +389,7 @@ int run(int argc, char** argv) {
   if (opt.bullet && !bulletAvailable()) {
     std::string why;
     PeerResult unused;
-    runBulletPeer(takes[0], 0, 0, 0, opt.bullet_field_m, unused, why);
+    runBulletPeer(takes[0], 0, 0, 0, opt.bullet_field_m, PeerDriver{}, unused, why);
     report.peer_note = why;
     std::fprintf(stderr, "drape-bench: note: %s\n", why.c_str());
   } else if (opt.bullet) {
@@ -410,30 +411,40 @@ int run(int argc, char** argv) {
     // Every take in a full run (the BVH take is replayed at 60 Hz, the rate Bullet's and NvCloth's
     // figures are quoted for); the first one with --quick.
     const size_t peer_takes = opt.quick ? 1 : takes.size();
+    // Bullet 4 x 10 on the peer's field once per Drape setting, started from that setting's shirt
+    // (Bullet's stretch follows the shirt it starts from); the other Bullet settings from the
+    // default's.
+    const std::vector<PeerDriver> drivers = peerDrivers();
+    auto isTarget = [&](const PeerSetting& ps) { return ps.substeps == 4 && ps.iterations == 10 && ps.field_m == f; };
     for (size_t ti = 0; ti < peer_takes; ++ti) {
       for (const PeerSetting& ps : settings) {
-        PeerResult p;
-        const auto t0 = std::chrono::steady_clock::now();
-        if (!runBulletPeer(takes[ti], table1_target, ps.substeps, ps.iterations, ps.field_m, p, err)) {
-          std::fprintf(stderr, "drape-bench: error: Bullet peer: %s\n", err.c_str());
-          return kExitFailure;
+        for (size_t di = 0; di < (isTarget(ps) ? drivers.size() : 1); ++di) {
+          PeerResult p;
+          const auto t0 = std::chrono::steady_clock::now();
+          if (!runBulletPeer(takes[ti], table1_target, ps.substeps, ps.iterations, ps.field_m, drivers[di], p, err)) {
+            std::fprintf(stderr, "drape-bench: error: Bullet peer: %s\n", err.c_str());
+            return kExitFailure;
+          }
+          std::fprintf(stderr, "drape-bench: Bullet %s on %s: %.2f CPU ms per frame, Drape (%s) %.3f: %.0fx (%.1f s)\n",
+                       p.label.c_str(), p.take.c_str(), median(p.bullet.cpu_ms), p.driver.label.c_str(),
+                       median(p.drape.cpu_ms), median(p.bullet.cpu_ms) / median(p.drape.cpu_ms),
+                       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+          report.peers.push_back(p);
         }
-        std::fprintf(stderr, "drape-bench: Bullet %s on %s: %.2f CPU ms per frame, Drape %.3f: %.0fx (%.1f s)\n",
-                     p.label.c_str(), p.take.c_str(), median(p.bullet.cpu_ms), median(p.drape.cpu_ms),
-                     median(p.bullet.cpu_ms) / median(p.drape.cpu_ms),
-                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-        report.peers.push_back(p);
       }
-      // --peer-spread: Bullet 4 x 10 on the peer's field again from other starting shirts.
-      for (int seed = 1; seed <= opt.peer_spread; ++seed) {
-        PeerResult p;
-        if (!runBulletPeer(takes[ti], table1_target, 4, 10, f, p, err, static_cast<uint32_t>(seed))) {
-          std::fprintf(stderr, "drape-bench: error: Bullet peer: %s\n", err.c_str());
-          return kExitFailure;
+      // --peer-spread: Bullet 4 x 10 on the peer's field again from other starting shirts, per setting.
+      for (const PeerDriver& driver : drivers) {
+        for (int seed = 1; seed <= opt.peer_spread; ++seed) {
+          PeerResult p;
+          if (!runBulletPeer(takes[ti], table1_target, 4, 10, f, driver, p, err, static_cast<uint32_t>(seed))) {
+            std::fprintf(stderr, "drape-bench: error: Bullet peer: %s\n", err.c_str());
+            return kExitFailure;
+          }
+          std::fprintf(stderr, "drape-bench: Bullet %s on %s from Drape's %s shirt: stretch P99 %.2f %%, penetration P99 %.2f mm\n",
+                       p.label.c_str(), p.take.c_str(), driver.label.c_str(), 100.0 * p.bullet.stretch_p99,
+                       p.bullet.penetration_p99_mm);
+          report.spread.push_back(p);
         }
-        std::fprintf(stderr, "drape-bench: Bullet %s on %s: stretch P99 %.2f %%, penetration P99 %.2f mm\n",
-                     p.label.c_str(), p.take.c_str(), 100.0 * p.bullet.stretch_p99, p.bullet.penetration_p99_mm);
-        report.spread.push_back(p);
       }
     }
     if (!writePeerCsv((fs::path(opt.out) / "bullet_peer.csv").string(), report.peers, err) ||

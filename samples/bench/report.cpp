@@ -95,46 +95,37 @@ void renderReferences(const ReportInput& in, std::string& o) {
   }
 }
 
-// --peer-spread: per take, Bullet 4 x 10 (the peer's field) from its usual start and from the
-// seeds' starting shirts, against Drape's two settings (the same in every run: Drape's start is
-// not perturbed).
+// --peer-spread: per take and Drape setting, Bullet 4 x 10 (the peer's field) from that setting's
+// shirt and from the seeds' shifted copies of it, against Drape at that setting (the same in every
+// run: Drape's start is not perturbed).
 void renderSpread(const ReportInput& in, std::string& o) {
-  std::vector<std::string> takes;
-  for (const PeerResult& p : in.spread)
-    if (std::find(takes.begin(), takes.end(), p.take) == takes.end()) takes.push_back(p.take);
-  if (takes.empty()) return;
+  if (in.spread.empty()) return;
   appendf(o,
           "\n## Bullet 4 x 10 over several starting shirts (`--peer-spread`)\n\n"
           "Bullet's free nodes start shifted together by %.1f mm (a direction drawn per seed) from where Drape "
-          "placed them; seed 0 is the run above. Drape starts as above in every run.\n\n"
-          "| take | starts | Bullet stretch %% P99: min / median / max | Bullet penetration mm P99: min / median / "
-          "max | Drape's default: stretch %% P99, penetration mm, stretch below Bullet's | Drape at %s: the same |\n"
-          "|---|---|---|---|---|---|\n",
-          1000.0 * kStartShiftM, lessStretchLabel().c_str());
-  for (const std::string& take : takes) {
-    std::vector<const PeerResult*> runs;
-    for (const PeerResult& p : in.peers)
-      if (p.take == take && p.substeps_per_60hz == 4 && p.iterations == 10 && p.sdf_voxel_m == in.peer_field_m)
-        runs.push_back(&p);
+          "at the setting placed them; seed 0 is the run above. Drape starts as above in every run.\n\n"
+          "| take | Drape setting (Bullet from its shirt) | starts | Bullet stretch %% P99: min / median / max | "
+          "Bullet penetration mm P99: min / median / max | Drape: stretch %% P99, penetration mm | Drape's stretch "
+          "below Bullet's |\n|---|---|---|---|---|---|---|\n",
+          1000.0 * kStartShiftM);
+  for (const PeerResult& head : in.peers) {
+    if (head.substeps_per_60hz != 4 || head.iterations != 10 || head.sdf_voxel_m != in.peer_field_m) continue;
+    std::vector<const PeerResult*> runs = {&head};
     for (const PeerResult& p : in.spread)
-      if (p.take == take) runs.push_back(&p);
+      if (p.take == head.take && p.driver.label == head.driver.label) runs.push_back(&p);
+    if (runs.size() < 2) continue;
     std::vector<double> stretch, pen;
+    int below = 0;
     for (const PeerResult* p : runs) {
       stretch.push_back(100.0 * p->bullet.stretch_p99);
       pen.push_back(p->bullet.penetration_p99_mm);
+      below += head.drape.stretch_p99 < p->bullet.stretch_p99 ? 1 : 0;
     }
-    auto below = [&](const PeerSide& d) {
-      int n = 0;
-      for (const PeerResult* p : runs) n += d.stretch_p99 < p->bullet.stretch_p99 ? 1 : 0;
-      return n;
-    };
-    const PeerResult& first = *runs.front();
-    appendf(o, "| %s | %zu | %.2f / %.2f / %.2f | %.2f / %.2f / %.2f | %.2f, %.2f, in %d of %zu | %.2f, %.2f, in %d of %zu |\n",
-            take.c_str(), runs.size(), *std::min_element(stretch.begin(), stretch.end()), median(stretch),
-            *std::max_element(stretch.begin(), stretch.end()), *std::min_element(pen.begin(), pen.end()), median(pen),
-            *std::max_element(pen.begin(), pen.end()), 100.0 * first.drape.stretch_p99,
-            first.drape.penetration_p99_mm, below(first.drape), runs.size(), 100.0 * first.drape_less.stretch_p99,
-            first.drape_less.penetration_p99_mm, below(first.drape_less), runs.size());
+    appendf(o, "| %s | %s | %zu | %.2f / %.2f / %.2f | %.2f / %.2f / %.2f | %.2f, %.2f | in %d of %zu |\n",
+            head.take.c_str(), head.driver.label.c_str(), runs.size(), *std::min_element(stretch.begin(), stretch.end()),
+            median(stretch), *std::max_element(stretch.begin(), stretch.end()), *std::min_element(pen.begin(), pen.end()),
+            median(pen), *std::max_element(pen.begin(), pen.end()), 100.0 * head.drape.stretch_p99,
+            head.drape.penetration_p99_mm, below, runs.size());
   }
 }
 
@@ -220,12 +211,15 @@ std::string renderReport(const ReportInput& in) {
   if (in.peers.empty()) {
     o += in.peer_note.empty() ? std::string("Not run.\n") : in.peer_note + "\n";
   } else {
-    o += "The same mesh, attachments, ellipsoids and frames for both. Time: thread CPU time per frame, median "
+    o += "The same mesh, attachments, ellipsoids and frames for both. Drape runs at a setting and Bullet starts "
+         "from that setting's dressed shirt (Bullet's stretch follows the shirt it starts from, docs/benchmarks.md): "
+         "Bullet 4 x 10 on the peer's field once per Drape setting, the other Bullet settings from the default's "
+         "shirt. Time: thread CPU time per frame, median "
          "(Bullet: its stepSimulation calls; Drape: push + its whole step, skeleton to cloth, measured beside it in "
          "the same frame); wall time of the cloth step alone in brackets. Penetration and stretch by the same meters "
          "for both; in body = vertex-frames inside the body mesh at any depth (ANCHORS.md's \"cloth inside the "
          "body\": NvCloth 0.40 %, Bullet 4 x 10 2.2 %); off = frames with an opening (hem, collar, a sleeve's "
-         "cuff) off the body part it went round at the start, by one meter for all three (OpeningsMeter: the "
+         "cuff) off the body part it went round at the start, by one meter for both (OpeningsMeter: the "
          "library's linking test on body parts through the ellipsoids' centres); inside = free vertices inside any tracking ellipsoid (Drape's garments collide only with their "
          "own body parts' ellipsoids, so sleeve cloth resting on the torso counts here). Bullet meets the "
          "ellipsoids through a distance field sampled on a voxel grid (the setting's field); Bullet's own 0.25 m "
@@ -245,41 +239,33 @@ std::string renderReport(const ReportInput& in) {
               100.0 * p.bullet.stretch_p99, 100.0 * p.bullet.stretch_max, p.bullet.penetration_p99_mm,
               p.bullet.penetration_max_mm, 100.0 * p.bullet.deeper_than_2mm, 100.0 * p.bullet.in_body,
               100.0 * p.bullet.openings_off, p.bullet.inside_mean);
-      appendf(
-          o, "| | Drape | default, beside it | %.3f (%.3f) | %.3f | 1 | %.2f / %.1f | %.2f / %.1f | %.2f | %.2f | %.0f | %.2f |\n",
-          d, dw, d * p.rate_hz / 60.0, 100.0 * p.drape.stretch_p99, 100.0 * p.drape.stretch_max,
-          p.drape.penetration_p99_mm, p.drape.penetration_max_mm, 100.0 * p.drape.deeper_than_2mm,
-          100.0 * p.drape.in_body, 100.0 * p.drape.openings_off, p.drape.inside_mean);
-      const PeerSide& l = p.drape_less;
-      const double lc = median(l.cpu_ms), lw = median(l.ms);
-      appendf(o,
-              "| | Drape | %s, beside it | %.3f (%.3f) | %.3f | **%.0fx**; %.0fx | "
-              "%.2f / %.1f | %.2f / %.1f | %.2f | %.2f | %.0f | %.2f |\n",
-              lessStretchLabel().c_str(), lc, lw, lc * p.rate_hz / 60.0, b / lc, bw / lw,
-              100.0 * l.stretch_p99, 100.0 * l.stretch_max, l.penetration_p99_mm, l.penetration_max_mm,
-              100.0 * l.deeper_than_2mm, 100.0 * l.in_body, 100.0 * l.openings_off, l.inside_mean);
+      appendf(o, "| | Drape | %s, beside it | %.3f (%.3f) | %.3f | 1 | %.2f / %.1f | %.2f / %.1f | %.2f | %.2f | %.0f | %.2f |\n",
+              p.driver.label.c_str(), d, dw, d * p.rate_hz / 60.0, 100.0 * p.drape.stretch_p99,
+              100.0 * p.drape.stretch_max, p.drape.penetration_p99_mm, p.drape.penetration_max_mm,
+              100.0 * p.drape.deeper_than_2mm, 100.0 * p.drape.in_body, 100.0 * p.drape.openings_off,
+              p.drape.inside_mean);
     }
+    // The target at each setting, against Bullet from that setting's shirt.
     for (const PeerResult& p : in.peers) {
       if (p.substeps_per_60hz != 4 || p.iterations != 10 || p.sdf_voxel_m != in.peer_field_m) continue;
-      // The target at the default, then at the setting with less stretch.
-      for (int side = 0; side < 2; ++side) {
-        const PeerSide& d = side == 0 ? p.drape : p.drape_less;
-        const double ratio = median(p.bullet.cpu_ms) / median(d.cpu_ms);
-        const bool less_pen = d.penetration_p99_mm <= p.bullet.penetration_p99_mm &&
-                              d.deeper_than_2mm <= p.bullet.deeper_than_2mm;
-        const bool less_stretch = d.stretch_p99 < p.bullet.stretch_p99;
-        const std::string setting = side == 0 ? "Drape's default" : "Drape at " + lessStretchLabel();
-        appendf(o,
-                "\nTarget on `%s` (Drape >= 50x faster than Bullet 4 x 10, with less penetration and stretch; "
-                "Bullet on its %g cm field), %s: %.0fx faster in CPU time (%s), penetration %s, stretch %s "
-                "(an opening off its body part in %.0f %% of the frames, Bullet's in %.0f %%).%s",
-                p.take.c_str(), 100.0 * p.sdf_voxel_m, setting.c_str(), ratio, ratio >= 50.0 ? "met" : "NOT met",
-                less_pen ? "less (met)" : "NOT less", less_stretch ? "less (met)" : "NOT less",
-                100.0 * d.openings_off, 100.0 * p.bullet.openings_off, side == 0 ? "" : "\n");
-        if (side == 0)
-          appendf(o, " Bullet 4 x 10 here: %.1f ms per 1/60 s (ANCHORS.md: %.0f ms).\n",
-                  median(p.bullet.cpu_ms) * p.rate_hz / 60.0, kBulletAnchorMsPer60Hz);
-      }
+      const PeerSide& d = p.drape;
+      const double ratio = median(p.bullet.cpu_ms) / median(d.cpu_ms);
+      const bool less_pen =
+          d.penetration_p99_mm <= p.bullet.penetration_p99_mm && d.deeper_than_2mm <= p.bullet.deeper_than_2mm;
+      const bool less_stretch = d.stretch_p99 < p.bullet.stretch_p99;
+      const std::string setting = p.driver.isDefault() ? "Drape's default" : "Drape at " + p.driver.label;
+      appendf(o,
+              "\nTarget on `%s` (Drape >= 50x faster than Bullet 4 x 10, with less penetration and stretch; "
+              "Bullet on its %g cm field, from the setting's shirt), %s: %.0fx faster in CPU time (%s), penetration "
+              "%s, stretch %s (%.2f against %.2f %%; an opening off its body part in %.0f %% of the frames, "
+              "Bullet's in %.0f %%).",
+              p.take.c_str(), 100.0 * p.sdf_voxel_m, setting.c_str(), ratio, ratio >= 50.0 ? "met" : "NOT met",
+              less_pen ? "less (met)" : "NOT less", less_stretch ? "less (met)" : "NOT less", 100.0 * d.stretch_p99,
+              100.0 * p.bullet.stretch_p99, 100.0 * d.openings_off, 100.0 * p.bullet.openings_off);
+      if (p.driver.isDefault())
+        appendf(o, " Bullet 4 x 10 here: %.1f ms per 1/60 s (ANCHORS.md: %.0f ms).",
+                median(p.bullet.cpu_ms) * p.rate_hz / 60.0, kBulletAnchorMsPer60Hz);
+      o += "\n";
     }
   }
 
@@ -304,7 +290,9 @@ std::string renderReport(const ReportInput& in) {
       appendf(o, "| Drape default, whole frame (skeleton + body + proxies + cloth) | %.1f | %.2fx %s |\n", frame,
               frame > nv ? frame / nv : nv / frame, frame > nv ? "slower" : "faster");
       for (const PeerResult& p : in.peers) {
-        if (p.take != d->take || p.substeps_per_60hz != 4 || p.sdf_voxel_m != in.peer_field_m) continue;
+        if (p.take != d->take || p.substeps_per_60hz != 4 || p.sdf_voxel_m != in.peer_field_m ||
+            !p.driver.isDefault())
+          continue;
         const double cpu = median(p.drape.cpu_ms) * p.rate_hz;
         appendf(o, "| Drape default, whole frame, thread CPU time (beside Bullet, same garment) | %.1f | %.2fx %s |\n",
                 cpu, cpu > nv ? cpu / nv : nv / cpu, cpu > nv ? "slower" : "faster");

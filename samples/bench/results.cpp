@@ -86,10 +86,11 @@ bool writeRowsCsv(const std::string& path, const std::vector<Row>& rows, std::st
   return true;
 }
 
-std::string lessStretchLabel() {
-  char label[64];
-  std::snprintf(label, sizeof label, "strain limit %g %% x %u passes", 100.0 * kLessStretchLimit, kLessStretchPasses);
-  return label;
+std::vector<PeerDriver> peerDrivers() {
+  char less[64];
+  std::snprintf(less, sizeof less, "strain limit %g %% x %u passes", 100.0 * kLessStretchLimit, kLessStretchPasses);
+  return {PeerDriver{"default"}, PeerDriver{less, 0, kLessStretchLimit, kLessStretchPasses},
+          PeerDriver{std::string("2 iterations + ") + less, 2, kLessStretchLimit, kLessStretchPasses}};
 }
 
 bool writePeerCsv(const std::string& path, const std::vector<PeerResult>& peers, std::string& error) {
@@ -100,29 +101,28 @@ bool writePeerCsv(const std::string& path, const std::vector<PeerResult>& peers,
   }
   // cpu_*: thread CPU time (Bullet: stepSimulation; Drape: push + whole step); wall_*: wall time
   // (Bullet: stepSimulation; Drape: its garment step as drape_garment_get_stats reports it).
-  // Three rows per peer run: Bullet, Drape at its default (which drives Bullet) and Drape at the
-  // setting with less stretch beside it; bullet_over_drape_*: on Bullet's row Bullet over Drape's
-  // default, on a Drape row Bullet over that row.
+  // Two rows per peer run: Bullet, started from the shirt of Drape at drape_setting, and Drape at
+  // that setting (the driver); bullet_over_drape_*: Bullet over that Drape, on both rows.
   std::fputs(
-      "engine,setting,take,rate_hz,particles,substeps_per_60hz,iterations,frames,cpu_ms_median,cpu_ms_p90,"
-      "cpu_ms_per_60hz,cpu_ms_per_sim_s,bullet_over_drape_cpu,wall_ms_median,wall_ms_p90,"
+      "engine,setting,drape_setting,take,rate_hz,particles,substeps_per_60hz,iterations,frames,cpu_ms_median,"
+      "cpu_ms_p90,cpu_ms_per_60hz,cpu_ms_per_sim_s,bullet_over_drape_cpu,wall_ms_median,wall_ms_p90,"
       "bullet_over_drape_wall,stretch_p99_pct,stretch_max_pct,pen_p99_mm,pen_max_mm,deeper_2mm_pct,"
       "inside_mean,sdf_voxel_m,in_body_pct,openings_off_pct\n",
       f.get());
-  const std::string less_label = lessStretchLabel();
   for (const PeerResult& p : peers) {
     const double bullet_cpu = median(p.bullet.cpu_ms), bullet_wall = median(p.bullet.ms);
-    for (int side = 0; side < 3; ++side) {
-      const PeerSide& s = side == 0 ? p.bullet : side == 1 ? p.drape : p.drape_less;
-      const PeerSide& over = side == 0 ? p.drape : s;
+    for (int side = 0; side < 2; ++side) {
+      const PeerSide& s = side == 0 ? p.bullet : p.drape;
       const double cpu = median(s.cpu_ms);
       std::fprintf(
-          f.get(), "%s,%s,%s,%.4g,%u,%d,%d,%zu,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.4g\n",
-          side == 0 ? "bullet" : "drape",
-          side == 0 ? csvText(p.label).c_str() : side == 1 ? "default" : less_label.c_str(), csvText(p.take).c_str(),
-          p.rate_hz, p.particles, side == 0 ? p.substeps_per_60hz : 0, side == 0 ? p.iterations : 0, s.cpu_ms.size(),
-          cpu, percentile(s.cpu_ms, 90.0), cpu * p.rate_hz / 60.0, cpu * p.rate_hz, bullet_cpu / median(over.cpu_ms),
-          median(s.ms), percentile(s.ms, 90.0), bullet_wall / median(over.ms), 100.0 * s.stretch_p99,
+          f.get(),
+          "%s,%s,%s,%s,%.4g,%u,%d,%d,%zu,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,"
+          "%.5g,%.4g\n",
+          side == 0 ? "bullet" : "drape", side == 0 ? csvText(p.label).c_str() : csvText(p.driver.label).c_str(),
+          csvText(p.driver.label).c_str(), csvText(p.take).c_str(), p.rate_hz, p.particles,
+          side == 0 ? p.substeps_per_60hz : 0, side == 0 ? p.iterations : 0, s.cpu_ms.size(), cpu,
+          percentile(s.cpu_ms, 90.0), cpu * p.rate_hz / 60.0, cpu * p.rate_hz, bullet_cpu / median(p.drape.cpu_ms),
+          median(s.ms), percentile(s.ms, 90.0), bullet_wall / median(p.drape.ms), 100.0 * s.stretch_p99,
           100.0 * s.stretch_max, s.penetration_p99_mm, s.penetration_max_mm, 100.0 * s.deeper_than_2mm, s.inside_mean,
           side == 0 ? p.sdf_voxel_m : 0.0, 100.0 * s.in_body, 100.0 * s.openings_off);
     }
