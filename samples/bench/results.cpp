@@ -87,10 +87,15 @@ bool writeRowsCsv(const std::string& path, const std::vector<Row>& rows, std::st
 }
 
 std::vector<PeerDriver> peerDrivers() {
-  char less[64];
-  std::snprintf(less, sizeof less, "strain limit %g %% x %u passes", 100.0 * kLessStretchLimit, kLessStretchPasses);
-  return {PeerDriver{"default"}, PeerDriver{less, 0, kLessStretchLimit, kLessStretchPasses},
-          PeerDriver{std::string("2 iterations + ") + less, 2, kLessStretchLimit, kLessStretchPasses}};
+  auto label = [](uint32_t iterations, float limit, uint32_t passes) {
+    char l[96];
+    std::snprintf(l, sizeof l, "%sstrain limit %g %% x %u passes", iterations > 1 ? "2 iterations + " : "",
+                  100.0 * limit, passes);
+    return std::string(l);
+  };
+  return {PeerDriver{"default"},
+          PeerDriver{label(0, kLessStretchLimit, kLessStretchPasses), 0, kLessStretchLimit, kLessStretchPasses},
+          PeerDriver{label(kPeerIterations, kPeerLimit, kPeerPasses), kPeerIterations, kPeerLimit, kPeerPasses}};
 }
 
 bool writePeerCsv(const std::string& path, const std::vector<PeerResult>& peers, std::string& error) {
