@@ -88,9 +88,10 @@ bool writeRowsCsv(const std::string& path, const std::vector<Row>& rows, std::st
 
 std::vector<PeerDriver> peerDrivers() {
   auto label = [](uint32_t iterations, float limit, uint32_t passes) {
+    char its[32] = "";
+    if (iterations > 1) std::snprintf(its, sizeof its, "%u iterations + ", iterations);
     char l[96];
-    std::snprintf(l, sizeof l, "%sstrain limit %g %% x %u passes", iterations > 1 ? "2 iterations + " : "",
-                  100.0 * limit, passes);
+    std::snprintf(l, sizeof l, "%sstrain limit %g %% x %u passes", its, 100.0 * limit, passes);
     return std::string(l);
   };
   return {PeerDriver{"default"},
