@@ -50,7 +50,7 @@ const Row* defaultRow(const ReportInput& in, const std::string& take) {
   return nullptr;
 }
 
-// The converged reference that prices `s` (the same model: every knob but substeps, iterations,
+// The converged reference that prices row `r` (the same model: every knob but substeps, iterations,
 // the strain limit and the backend, which the references share; main.cpp's Runner::row).
 const Row* referenceFor(const ReportInput& in, const Row& r) {
   for (const Row& ref : in.references) {
