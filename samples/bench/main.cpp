@@ -217,16 +217,8 @@ struct Runner {
     if (!runDrape(take, s, mo, measured, err)) return false;
     takeFigures(measured, r);
     r.device = measured.device;
-    // The converged reference of the same input, shared by every setting that differs only in
-    // substeps and iterations.
-    Setting ref_key_setting = s;
-    ref_key_setting.substep_hz = s.solver == DRAPE_SOLVER_MASS_SPRING ? kMassSpringSubstepHz : Setting{}.substep_hz;
-    ref_key_setting.iterations = 1;
-    // and in the strain limit: at the reference's 16x the substeps a chain's stretch is 1/256 of
-    // the default's, so the limit hardly acts there; one reference prices every limit.
-    ref_key_setting.strain_limit = Setting{}.strain_limit;
-    ref_key_setting.strain_limit_passes = Setting{}.strain_limit_passes;
-    const Setting ref = ref_key_setting.reference(opt.quick);
+    // The converged reference of the same model (Setting::convergedReference).
+    const Setting ref = s.convergedReference(opt.quick);
     const std::string ref_id = ref.key() + "|" + take.name;
     if (!references.count(ref_id)) {
       RunResult rr;

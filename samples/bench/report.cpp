@@ -50,16 +50,11 @@ const Row* defaultRow(const ReportInput& in, const std::string& take) {
   return nullptr;
 }
 
-// The converged reference that prices row `r` (the same model: every knob but substeps, iterations,
-// the strain limit and the backend, which the references share; main.cpp's Runner::row).
+// The converged reference that prices row `r`: the one of its take and model (Setting::modelKey).
 const Row* referenceFor(const ReportInput& in, const Row& r) {
-  for (const Row& ref : in.references) {
-    const Setting &a = ref.setting, &b = r.setting;
-    if (ref.take == r.take && a.solver == b.solver && a.ring_points == b.ring_points && a.proxy_rule == b.proxy_rule &&
-        a.contact_response == b.contact_response && a.continuous_collision == b.continuous_collision &&
-        a.particles == b.particles)
-      return &ref;
-  }
+  const std::string model = r.setting.modelKey();
+  for (const Row& ref : in.references)
+    if (ref.take == r.take && ref.setting.modelKey() == model) return &ref;
   return nullptr;
 }
 

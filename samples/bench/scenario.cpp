@@ -98,6 +98,22 @@ std::string Setting::key() const {
   return buf;
 }
 
+std::string Setting::modelKey() const {
+  char buf[128];
+  std::snprintf(buf, sizeof buf, "s%d K%u rule%d resp%d ccd%u n%u", solver, ring_points, proxy_rule, contact_response,
+                continuous_collision, particles);
+  return buf;
+}
+
+Setting Setting::convergedReference(bool quick) const {
+  Setting base = *this;
+  base.substep_hz = solver == DRAPE_SOLVER_MASS_SPRING ? kMassSpringSubstepHz : Setting{}.substep_hz;
+  base.iterations = 1;
+  base.strain_limit = Setting{}.strain_limit;
+  base.strain_limit_passes = Setting{}.strain_limit_passes;
+  return base.reference(quick);
+}
+
 Setting Setting::reference(bool quick) const {
   Setting r = *this;
   r.sweep = "reference";

@@ -52,6 +52,15 @@ struct Setting {
   // quoted): XPBD 4x the substep rate and 2x the iterations (above every quick point, an eighth
   // of the work), mass-spring 2x the rate (the references were two thirds of a quick run).
   Setting reference(bool quick = false) const;
+  // The model a reference converges (solver, K, proxy rule, contact response, swept test,
+  // particles): settings that differ only in substeps, iterations, strain limit or backend share
+  // one converged reference, convergedReference().
+  std::string modelKey() const;
+  // That shared reference: the model at its solver's base substep rate, one iteration and the
+  // default strain limit, then reference(quick). The strain limit is left out because at the
+  // reference's 16x the substeps a chain's stretch is 1/256 of the default's, so the limit hardly
+  // acts there; one reference prices every limit.
+  Setting convergedReference(bool quick = false) const;
 };
 
 // The mass-spring solver's substep rate when none is given (drape-replay's: 96 per 1/30 s, the
